@@ -1,0 +1,120 @@
+// The contact law of dipper's spheres: linear spring-dashpot normal force, tangential spring with
+// history and Coulomb limit, viscous damping as a fraction of critical, and elastic-plastic rolling
+// resistance. Thesis Paper A eqs. 3-8; Cundall & Strack (1979); rolling spring of Ai, Chen, Rotter &
+// Ooi (2011, model type C without its viscous part). One pure function serves sphere-sphere and
+// sphere-wall contacts: a wall is the limit r2 -> inf, m2 -> inf of a sphere.
+#pragma once
+
+#include "core/vec3.h"
+#include "dem/material.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dipper::dem {
+
+/// Geometry and motion of one contact, computed by the caller. "This" body is the particle the force
+/// acts on; "other" is the second sphere or the wall.
+struct ContactState {
+    double overlap_m = 0.0;             ///< > 0 while touching
+    Vec3 normal;                        ///< unit, from the other body towards this one
+    Vec3 relative_velocity_m_per_s;     ///< contact-point velocity of this minus other
+    Vec3 relative_angular_velocity_rad_per_s;  ///< omega_this - omega_other
+    double effective_radius_m = 0.0;    ///< r1 r2 / (r1 + r2); r1 against a wall
+    double effective_mass_kg = 0.0;     ///< m1 m2 / (m1 + m2); m1 against a wall
+    double normal_stiffness_N_per_m = 0.0;  ///< Kn of eq. 4 (C_norm included)
+};
+
+/// Carried from step to step for each touching pair (and reset when the pair separates).
+struct ContactHistory {
+    Vec3 tangential_spring_m;   ///< accumulated tangential displacement, in the current tangent plane
+    Vec3 rolling_torque_N_m;    ///< rolling-spring torque on "this", in the current tangent plane
+};
+
+/// What the law returns for "this" body; the other body receives the opposite force and rolling torque.
+struct ContactForces {
+    double normal_force_N = 0.0;        ///< >= 0: the normal force is never attractive
+    Vec3 tangential_force_N;
+    Vec3 rolling_torque_N_m;
+};
+
+/// Normal stiffness of eq. 4: Kn = k1 r1 k2 r2 / (k1 r1 + k2 r2) C_norm, k the bulk modulus of eq. 5.
+inline double pair_normal_stiffness(double k1_Pa, double r1_m, double k2_Pa, double r2_m, double c_norm)
+{
+    const double a = k1_Pa * r1_m, b = k2_Pa * r2_m;
+    return a * b / (a + b) * c_norm;
+}
+/// The wall limit of eq. 4 (r2 -> inf): Kn = k1 r1 C.
+inline double wall_normal_stiffness(double k1_Pa, double r1_m, double c_norm) { return k1_Pa * r1_m * c_norm; }
+
+/// Rolling-spring stiffness k_r = 2.25 Kn mu_roll^2 R*^2 (Ai et al. 2011, eq. 18), N m / rad.
+inline double rolling_stiffness(double kn_N_per_m, double rolling_friction, double effective_radius_m)
+{
+    return 2.25 * kn_N_per_m * rolling_friction * rolling_friction * effective_radius_m * effective_radius_m;
+}
+
+/// Re-expresses a history vector in the current tangent plane (normal n), keeping its length, so that a
+/// rotating contact carries its spring along instead of growing a normal component.
+inline Vec3 rotate_into_tangent_plane(const Vec3& v, const Vec3& n)
+{
+    const double old_len2 = norm_squared(v);
+    if (old_len2 == 0.0) return v;
+    const Vec3 projected = v - n * dot(v, n);
+    const double new_len2 = norm_squared(projected);
+    if (new_len2 == 0.0) return Vec3{};
+    return projected * std::sqrt(old_len2 / new_len2);
+}
+
+/// The linear spring-dashpot law with Coulomb friction and rolling resistance.
+///
+/// Normal (eq. 3, 6): Fn = max(0, Kn delta - c_n v_n), c_n = D_n 2 sqrt(m* Kn). The clamp at zero means
+/// a separating pair loses contact force when the damping term cancels the spring, before the overlap
+/// closes; restitution is then higher than exp(-pi D / sqrt(1 - D^2)) (see docs/contact_model.md).
+/// Tangential: xi += v_t dt; Ft = -Kt xi - c_t v_t, Kt = C_tan Kn, c_t = D_t 2 sqrt(m* Kt); if
+/// |Ft| > mu Fn the force is scaled to mu Fn and the spring reset to xi = -(Ft + c_t v_t) / Kt, so that
+/// sliding dissipates and never stores more than the Coulomb limit (eq. 7).
+/// Rolling (eq. 8): Mr -= k_r omega_roll dt, |Mr| <= mu_roll R* Fn; omega_roll is the relative angular
+/// velocity in the tangent plane (twisting is not resisted).
+inline ContactForces linear_spring_dashpot(const ContactState& c, const PairCoefficients& p, ContactHistory& h,
+                                           double dt_s)
+{
+    ContactForces out;
+    const Vec3& n = c.normal;
+    const double kn = c.normal_stiffness_N_per_m;
+    const double critical_n = 2.0 * std::sqrt(c.effective_mass_kg * kn);
+
+    // normal: spring and dashpot, never attractive
+    const double vn = dot(c.relative_velocity_m_per_s, n);
+    const double fn = kn * c.overlap_m - p.normal_damping_ratio * critical_n * vn;
+    out.normal_force_N = fn > 0.0 ? fn : 0.0;
+
+    // tangential: history spring in the current tangent plane, dashpot, Coulomb limit
+    const Vec3 vt = c.relative_velocity_m_per_s - n * vn;
+    const double kt = p.tangential_stiffness_scale * kn;
+    const double ct = p.tangential_damping_ratio * critical_n * std::sqrt(p.tangential_stiffness_scale);
+    h.tangential_spring_m = rotate_into_tangent_plane(h.tangential_spring_m, n) + vt * dt_s;
+    Vec3 ft = h.tangential_spring_m * (-kt) - vt * ct;
+    const double ft2 = norm_squared(ft);
+    const double limit = p.friction * out.normal_force_N;
+    if (ft2 > limit * limit) {
+        ft = ft2 > 0.0 ? ft * (limit / std::sqrt(ft2)) : Vec3{};
+        h.tangential_spring_m = (ft + vt * ct) * (-1.0 / kt);
+    }
+    out.tangential_force_N = ft;
+
+    // rolling: elastic-plastic spring on the relative rolling rotation
+    if (p.rolling_friction > 0.0) {
+        const Vec3& w = c.relative_angular_velocity_rad_per_s;
+        const Vec3 w_roll = w - n * dot(w, n);
+        const double kr = rolling_stiffness(kn, p.rolling_friction, c.effective_radius_m);
+        Vec3 mr = rotate_into_tangent_plane(h.rolling_torque_N_m, n) - w_roll * (kr * dt_s);
+        const double mr2 = norm_squared(mr);
+        const double mr_limit = p.rolling_friction * c.effective_radius_m * out.normal_force_N;
+        if (mr2 > mr_limit * mr_limit) mr = mr2 > 0.0 ? mr * (mr_limit / std::sqrt(mr2)) : Vec3{};
+        h.rolling_torque_N_m = mr;
+        out.rolling_torque_N_m = mr;
+    }
+    return out;
+}
+
+}  // namespace dipper::dem

@@ -1,0 +1,79 @@
+// Materials and per-material-pair contact coefficients (thesis Paper A, Table 2).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dipper::dem {
+
+using MaterialIndex = std::uint16_t;
+
+/// A named material. Particle materials need density and elastic constants; a surface material (a
+/// wall, a bucket plate, the ground) is infinitely stiff and massive in the contact law (r2 -> inf),
+/// so its elastic constants are not used.
+struct Material {
+    std::string name;
+    double density_kg_per_m3 = 0.0;
+    double youngs_modulus_Pa = 0.0;
+    double poisson_ratio = 0.0;
+    bool is_surface = false;
+
+    /// Bulk modulus k = E / (3 (1 - 2 nu)), thesis eq. 5.
+    double bulk_modulus_Pa() const { return youngs_modulus_Pa / (3.0 * (1.0 - 2.0 * poisson_ratio)); }
+};
+
+/// Contact coefficients of one material pair, as in thesis Table 2.
+struct PairCoefficients {
+    double normal_stiffness_scale = 0.05;      ///< C_norm in Kn = k1 r1 k2 r2 / (k1 r1 + k2 r2) C_norm (eq. 4)
+    double tangential_stiffness_scale = 0.27;  ///< C_tan in Kt = C_tan Kn
+    double friction = 0.0;                     ///< Coulomb mu, |Ft| <= mu Fn (eq. 7)
+    double rolling_friction = 0.0;             ///< mu_roll, |Mr| <= r mu_roll Fn (eq. 8)
+    double normal_damping_ratio = 1.0;         ///< D_n: fraction of critical damping, 0..1 (eq. 6)
+    double tangential_damping_ratio = 1.0;     ///< D_t: fraction of critical damping, 0..1
+};
+
+/// The constant material model of a run: materials and a symmetric table of pair coefficients. Built
+/// and validated once; read-only (and so thread-safe) during the run.
+class MaterialTable {
+public:
+    /// Adds a material after validating it; returns its index. Names are unique.
+    MaterialIndex add(const Material& material);
+    /// Sets the coefficients of the pair (a, b) and (b, a) after validating them. `where` names the
+    /// source of the values for error messages.
+    void set_pair(MaterialIndex a, MaterialIndex b, const PairCoefficients& coefficients,
+                  const std::string& where = "set_pair");
+    void set_pair(const std::string& a, const std::string& b, const PairCoefficients& coefficients,
+                  const std::string& where = "set_pair");
+
+    std::size_t size() const { return materials_.size(); }
+    const Material& material(MaterialIndex i) const { return materials_.at(i); }
+    MaterialIndex index_of(const std::string& name) const;  ///< throws InputError listing the known names
+    bool has_pair(MaterialIndex a, MaterialIndex b) const { return defined_[a * materials_.size() + b]; }
+    /// Coefficients of a pair; throws InputError if the pair was never set.
+    const PairCoefficients& pair(MaterialIndex a, MaterialIndex b) const;
+    /// Same without the check, for hot loops over pairs that were checked at setup.
+    const PairCoefficients& pair_unchecked(MaterialIndex a, MaterialIndex b) const
+    {
+        return pairs_[a * materials_.size() + b];
+    }
+
+    /// Aitik copper ore of thesis Paper A Table 2: materials "ore" (spheres), "rock" (polyhedral rocks
+    /// seen by spheres), surfaces "ground", "bucket", "truck", and "steel" (any other machine surface,
+    /// Table 2's "DE-remaining", frictionless). Where Table 2 is silent the thesis says damping 1 and
+    /// stiffness scale 0.05; spheres against rocks take DE-DE rolling friction.
+    static MaterialTable aitik_copper_ore();
+
+private:
+    void check_index(MaterialIndex i, const std::string& where) const;
+
+    std::vector<Material> materials_;
+    std::vector<PairCoefficients> pairs_;
+    std::vector<bool> defined_;
+};
+
+/// Throws InputError naming the key and value if a coefficient is outside its range.
+void validate(const PairCoefficients& c, const std::string& where);
+void validate(const Material& m, const std::string& where);
+
+}  // namespace dipper::dem

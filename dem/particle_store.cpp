@@ -1,0 +1,75 @@
+#include "dem/particle_store.h"
+
+#include "core/errors.h"
+
+#include <cmath>
+
+namespace dipper::dem {
+
+double sphere_mass_kg(double radius_m, double density_kg_per_m3)
+{
+    return density_kg_per_m3 * 4.0 / 3.0 * M_PI * radius_m * radius_m * radius_m;
+}
+
+void ParticleStore::reserve(std::size_t n)
+{
+    for (auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m}) v->reserve(n);
+    for (auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) v->reserve(n);
+    material.reserve(n);
+    id.reserve(n);
+}
+
+std::uint32_t ParticleStore::add(const ParticleSpawn& s, const MaterialTable& materials, const std::string& where)
+{
+    require_positive(s.radius_m, "radius_m", where);
+    if (!is_finite(s.position_m)) throw InputError(concat("position_m must be finite (", where, ")"));
+    if (!is_finite(s.velocity_m_per_s)) throw InputError(concat("velocity_m_per_s must be finite (", where, ")"));
+    if (!is_finite(s.angular_velocity_rad_per_s))
+        throw InputError(concat("angular_velocity_rad_per_s must be finite (", where, ")"));
+    if (s.material >= materials.size())
+        throw InputError(concat("material index ", s.material, " does not exist; the table has ", materials.size(),
+                                " materials (", where, ")"));
+    const Material& m = materials.material(s.material);
+    if (m.is_surface)
+        throw InputError(concat("material '", m.name, "' is a surface material and cannot make a particle (", where, ")"));
+
+    const double mass = sphere_mass_kg(s.radius_m, m.density_kg_per_m3);
+    const double inertia = 0.4 * mass * s.radius_m * s.radius_m;  // solid sphere, 2/5 m r^2
+    position_m.push_back(s.position_m);
+    velocity_m_per_s.push_back(s.velocity_m_per_s);
+    angular_velocity_rad_per_s.push_back(s.angular_velocity_rad_per_s);
+    force_N.push_back({});
+    torque_N_m.push_back({});
+    radius_m.push_back(s.radius_m);
+    mass_kg.push_back(mass);
+    inverse_mass_per_kg.push_back(1.0 / mass);
+    inverse_inertia_per_kg_m2.push_back(1.0 / inertia);
+    material.push_back(s.material);
+    id.push_back(next_id_);
+    return next_id_++;
+}
+
+namespace {
+template <typename T>
+void apply_order(std::vector<T>& v, const std::vector<std::uint32_t>& order, std::vector<T>& scratch)
+{
+    scratch.resize(v.size());
+    for (std::size_t k = 0; k < order.size(); ++k) scratch[k] = v[order[k]];
+    v.swap(scratch);
+}
+}  // namespace
+
+void ParticleStore::permute(const std::vector<std::uint32_t>& order)
+{
+    std::vector<Vec3> s3;
+    std::vector<double> s1;
+    for (auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m})
+        apply_order(*v, order, s3);
+    for (auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) apply_order(*v, order, s1);
+    std::vector<MaterialIndex> sm;
+    apply_order(material, order, sm);
+    std::vector<std::uint32_t> si;
+    apply_order(id, order, si);
+}
+
+}  // namespace dipper::dem

@@ -1,0 +1,77 @@
+// Boundaries the spheres touch: analytic planes and triangle meshes that may move rigidly.
+#pragma once
+
+#include "core/vec3.h"
+#include "dem/material.h"
+#include "meshes/triangle_mesh.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dipper::dem {
+
+/// An infinite static plane; particles live on the side the normal points to.
+struct PlaneWall {
+    Vec3 point_m;
+    Vec3 normal;  ///< unit
+    MaterialIndex material = 0;
+    std::string name;
+};
+
+/// Rigid motion prescribed in time: body-frame point `pivot_m` (which coincides with the world point
+/// pivot_m at t = 0) moves as c(t) = pivot + v t + A sin(2 pi f t), and the body turns about it at a
+/// constant angular velocity. World position of body point x_b: c(t) + R(t) (x_b - pivot).
+struct PrescribedMotion {
+    Vec3 velocity_m_per_s;
+    Vec3 angular_velocity_rad_per_s;
+    Vec3 pivot_m;
+    Vec3 oscillation_amplitude_m;
+    double oscillation_frequency_Hz = 0.0;
+
+    /// Pose at time t: rotation and translation so that x_world = R x_body + T.
+    void pose(double t_s, Mat3& rotation, Vec3& translation_m) const;
+    /// Velocity of the pivot and angular velocity at time t.
+    Vec3 pivot_velocity_m_per_s(double t_s) const;
+    Vec3 pivot_position_m(double t_s) const;
+};
+
+/// A triangle mesh wall. The mesh is kept in its body frame; its world pose and velocity are set each
+/// step, either from a PrescribedMotion or from outside (the coupling module moves machine parts).
+class MeshWall {
+public:
+    MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::string name,
+             std::optional<PrescribedMotion> motion = std::nullopt);
+
+    /// Sets the pose (x_world = R x_body + T) and the rigid velocity field v(p) = v_ref + w x (p - ref).
+    void set_pose(const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_world_m,
+                  const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s);
+    /// Velocity of the wall material at a world point.
+    Vec3 velocity_at(const Vec3& point_world_m) const
+    {
+        return reference_velocity_ + cross(angular_velocity_, point_world_m - reference_point_);
+    }
+
+    const meshes::TriangleMesh& mesh() const { return mesh_; }
+    const std::vector<Vec3>& vertices_world_m() const { return vertices_world_; }
+    const Vec3& normal_world(std::size_t t) const { return normals_world_[t]; }
+    const Vec3& angular_velocity_rad_per_s() const { return angular_velocity_; }
+    const std::optional<PrescribedMotion>& motion() const { return motion_; }
+    MaterialIndex material() const { return material_; }
+    const std::string& name() const { return name_; }
+    const Mat3& rotation() const { return rotation_; }
+    const Vec3& translation_m() const { return translation_; }
+
+private:
+    meshes::TriangleMesh mesh_;
+    MaterialIndex material_;
+    std::string name_;
+    std::optional<PrescribedMotion> motion_;
+    Mat3 rotation_;
+    Vec3 translation_;
+    Vec3 reference_point_, reference_velocity_, angular_velocity_;
+    std::vector<Vec3> vertices_world_;
+    std::vector<Vec3> normals_world_;
+};
+
+}  // namespace dipper::dem

@@ -1,0 +1,930 @@
+#include "dem/world.h"
+
+#include "core/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <omp.h>
+
+namespace dipper::dem {
+
+namespace {
+
+/// Contiguous block [begin, end) of n items for thread t of T: each thread's output stays in index
+/// order, so concatenating per-thread results gives the same sequence for any thread count.
+void thread_block(std::size_t n, int t, int threads, std::size_t& begin, std::size_t& end)
+{
+    begin = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+    end = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
+}
+
+}  // namespace
+
+World::World(MaterialTable materials, WorldSettings settings) : materials_(std::move(materials)), settings_(settings)
+{
+    const std::string at = "WorldSettings";
+    if (!is_finite(settings_.gravity_m_per_s2)) throw InputError("gravity_m_per_s2 must be finite (WorldSettings)");
+    require_non_negative(settings_.step_s, "step_s", at);
+    require_positive(settings_.skin_fraction_of_radius, "skin_fraction_of_radius", at);
+    require_in_range(settings_.max_overlap_ratio, 1e-6, 1.0, "max_overlap_ratio", at);
+    require_in_range(settings_.initial_overlap_tolerance, 0.0, 1.0, "initial_overlap_tolerance", at);
+    if (settings_.threads < 0) throw InputError(concat("threads must be >= 0; got ", settings_.threads, " (", at, ")"));
+    threads_ = settings_.threads > 0 ? settings_.threads : omp_get_max_threads();
+    thread_wall_contacts_.resize(static_cast<std::size_t>(threads_));
+}
+
+std::uint32_t World::add_particle(const ParticleSpawn& spawn, const std::string& where)
+{
+    const std::uint32_t id = particles_.add(spawn, materials_, where);
+    // until its first force evaluation, a particle added during a run feels gravity only
+    particles_.force_N.back() = settings_.gravity_m_per_s2 * particles_.mass_kg.back();
+    rebuild_needed_ = true;
+    step_checked_ = false;
+    return id;
+}
+
+int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex material, const std::string& name)
+{
+    const std::string at = "plane '" + name + "'";
+    if (!is_finite(point_m) || !is_finite(normal) || norm(normal) < 1e-12)
+        throw InputError(concat("plane point and normal must be finite and the normal non-zero (", at, ")"));
+    if (material >= materials_.size())
+        throw InputError(concat("material index ", material, " does not exist (", at, ")"));
+    planes_.push_back({point_m, normalized(normal), material, name});
+    walls_.push_back({false, static_cast<int>(planes_.size() - 1)});
+    wall_force_N_.resize(walls_.size());
+    step_checked_ = false;
+    return static_cast<int>(walls_.size() - 1);
+}
+
+int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std::string& name,
+                    std::optional<PrescribedMotion> motion)
+{
+    if (material >= materials_.size())
+        throw InputError(concat("material index ", material, " does not exist (mesh '", name, "')"));
+    if (motion && !(is_finite(motion->velocity_m_per_s) && is_finite(motion->angular_velocity_rad_per_s) &&
+                    is_finite(motion->pivot_m) && is_finite(motion->oscillation_amplitude_m) &&
+                    std::isfinite(motion->oscillation_frequency_Hz)))
+        throw InputError(concat("prescribed motion of mesh '", name, "' must be finite"));
+    meshes_.emplace_back(std::move(mesh), material, name, motion);
+    if (motion) {
+        // place the mesh at the current time
+        Mat3 r;
+        Vec3 t;
+        motion->pose(time_s_, r, t);
+        meshes_.back().set_pose(r, t, motion->pivot_position_m(time_s_), motion->pivot_velocity_m_per_s(time_s_),
+                                motion->angular_velocity_rad_per_s);
+    }
+    walls_.push_back({true, static_cast<int>(meshes_.size() - 1)});
+    mesh_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
+    wall_force_N_.resize(walls_.size());
+    rebuild_needed_ = true;
+    step_checked_ = false;
+    return static_cast<int>(walls_.size() - 1);
+}
+
+void World::set_mesh_pose(int wall_id, const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_m,
+                          const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s)
+{
+    if (!is_mesh(wall_id)) throw InputError(concat("wall ", wall_id, " is not a mesh wall"));
+    meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index)].set_pose(
+        rotation, translation_m, reference_point_m, reference_velocity_m_per_s, angular_velocity_rad_per_s);
+}
+
+bool World::is_mesh(int wall_id) const
+{
+    if (wall_id < 0 || static_cast<std::size_t>(wall_id) >= walls_.size())
+        throw InputError(concat("wall id ", wall_id, " does not exist; the world has ", walls_.size(), " walls"));
+    return walls_[static_cast<std::size_t>(wall_id)].is_mesh;
+}
+
+const MeshWall& World::mesh_wall(int wall_id) const
+{
+    if (!is_mesh(wall_id)) throw InputError(concat("wall ", wall_id, " is not a mesh wall"));
+    return meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index)];
+}
+
+const PlaneWall& World::plane_wall(int wall_id) const
+{
+    if (is_mesh(wall_id)) throw InputError(concat("wall ", wall_id, " is not a plane"));
+    return planes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index)];
+}
+
+const std::string& World::wall_name(int wall_id) const
+{
+    return is_mesh(wall_id) ? mesh_wall(wall_id).name() : plane_wall(wall_id).name;
+}
+
+Vec3 World::wall_force_N(int wall_id) const
+{
+    is_mesh(wall_id);  // validates the id
+    return wall_force_N_[static_cast<std::size_t>(wall_id)];
+}
+
+// ---- time step -----------------------------------------------------------------------------------
+
+double World::reference_step_s() const
+{
+    // The stiffest contact particle i can have is against a wall (eq. 4 with r2 -> inf): k_i r_i C,
+    // with C the largest C_norm of any pair its material has. A sphere pair has m* K <= m_i k_i r_i C.
+    std::vector<double> max_scale(materials_.size(), 0.0);
+    for (std::size_t a = 0; a < materials_.size(); ++a)
+        for (std::size_t b = 0; b < materials_.size(); ++b)
+            if (materials_.has_pair(static_cast<MaterialIndex>(a), static_cast<MaterialIndex>(b)))
+                max_scale[a] = std::max(max_scale[a], materials_.pair_unchecked(static_cast<MaterialIndex>(a),
+                                                                                static_cast<MaterialIndex>(b))
+                                                          .normal_stiffness_scale);
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+        const MaterialIndex a = particles_.material[i];
+        const double k = materials_.material(a).bulk_modulus_Pa() * particles_.radius_m[i] * max_scale[a];
+        if (k > 0.0) best = std::min(best, std::sqrt(particles_.mass_kg[i] / k));
+    }
+    return best;
+}
+
+double World::step_s() const
+{
+    if (settings_.step_s > 0.0) return settings_.step_s;
+    return kDefaultStepFactor * reference_step_s();
+}
+
+void World::validate_step()
+{
+    // every material pair that can meet must have coefficients
+    std::vector<bool> present(materials_.size(), false);
+    for (MaterialIndex m : particles_.material) present[m] = true;
+    for (std::size_t a = 0; a < materials_.size(); ++a) {
+        if (!present[a]) continue;
+        for (std::size_t b = 0; b < materials_.size(); ++b)
+            if (present[b]) materials_.pair(static_cast<MaterialIndex>(a), static_cast<MaterialIndex>(b));
+        for (const PlaneWall& p : planes_) materials_.pair(static_cast<MaterialIndex>(a), p.material);
+        for (const MeshWall& m : meshes_) materials_.pair(static_cast<MaterialIndex>(a), m.material());
+    }
+
+    const double reference = reference_step_s();
+    const double limit = kStableStepFactor * reference;
+    if (settings_.step_s > 0.0) {
+        if (settings_.step_s > limit)
+            throw InputError(concat("step_s = ", settings_.step_s, " s exceeds the stable limit ", limit, " s (",
+                                    kStableStepFactor, " x sqrt(m/K) = ", kStableStepFactor, " x ", reference,
+                                    " s for the smallest, stiffest particle); use step_s <= ", limit,
+                                    " s or leave it 0 for the default ", kDefaultStepFactor * reference, " s"));
+        step_s_ = settings_.step_s;
+    } else {
+        step_s_ = std::isfinite(reference) ? kDefaultStepFactor * reference : 0.0;
+    }
+    step_checked_ = true;
+}
+
+// ---- stepping ------------------------------------------------------------------------------------
+
+void World::prepare()
+{
+    if (!step_checked_) validate_step();
+    if (!prepared_) {
+        rebuild();
+        check_initial_overlaps();
+        // velocity Verlet starts from the forces of the initial state; a zero-length step leaves the
+        // contact springs where they are
+        evaluate_forces(0.0);
+        prepared_ = true;
+    }
+}
+
+void World::evaluate_forces(double dt_s)
+{
+    compute_pair_forces(dt_s);
+    compute_wall_contacts(dt_s);
+    gather_forces();
+}
+
+void World::run_steps(std::uint64_t n)
+{
+    for (std::uint64_t s = 0; s < n; ++s) step();
+}
+
+void World::step()
+{
+    prepare();
+    const double dt = step_s_;
+    if (!(dt > 0.0)) throw InputError("the world has no particles to derive a time step from and step_s is 0");
+    const std::size_t n = particles_.size();
+    auto& x = particles_.position_m;
+    auto& v = particles_.velocity_m_per_s;
+    auto& w = particles_.angular_velocity_rad_per_s;
+
+    // first half kick with last step's forces, then drift (velocity Verlet)
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (std::size_t i = 0; i < n; ++i) {
+        v[i] += particles_.force_N[i] * (0.5 * dt * particles_.inverse_mass_per_kg[i]);
+        w[i] += particles_.torque_N_m[i] * (0.5 * dt * particles_.inverse_inertia_per_kg_m2[i]);
+        x[i] += v[i] * dt;
+    }
+
+    // moving walls to the end of the step, their velocities at mid-step
+    move_prescribed_meshes(time_s_ + dt, dt);
+
+    // neighbour lists, rebuilt when a particle or a wall has used up the skin
+    if (rebuild_needed_ || needs_rebuild()) rebuild();
+
+    // forces: sphere pairs into per-pair slots, wall contacts per particle, then a gather per particle
+    evaluate_forces(dt);
+
+    // second half kick with the new forces
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (std::size_t i = 0; i < n; ++i) {
+        v[i] += particles_.force_N[i] * (0.5 * dt * particles_.inverse_mass_per_kg[i]);
+        w[i] += particles_.torque_N_m[i] * (0.5 * dt * particles_.inverse_inertia_per_kg_m2[i]);
+    }
+    finish_step(dt);
+}
+
+void World::move_prescribed_meshes(double t_end_s, double dt_s)
+{
+    for (MeshWall& m : meshes_) {
+        if (!m.motion()) continue;
+        const PrescribedMotion& motion = *m.motion();
+        Mat3 r;
+        Vec3 t;
+        motion.pose(t_end_s, r, t);
+        // the rigid velocity field at mid-step, referred to the pivot's position at the end of the step
+        const Vec3 mid_velocity = motion.pivot_velocity_m_per_s(t_end_s - 0.5 * dt_s);
+        m.set_pose(r, t, motion.pivot_position_m(t_end_s), mid_velocity, motion.angular_velocity_rad_per_s);
+    }
+}
+
+bool World::needs_rebuild() const
+{
+    const std::size_t n = particles_.size();
+    double max_d2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : max_d2) num_threads(threads_)
+    for (std::size_t i = 0; i < n; ++i)
+        max_d2 = std::max(max_d2, norm_squared(particles_.position_m[i] - reference_position_m_[i]));
+    const double particle_move = std::sqrt(max_d2);
+    if (2.0 * particle_move > skin_m_) return true;
+
+    double mesh_move2 = 0.0;
+    for (std::size_t m = 0; m < meshes_.size(); ++m) {
+        if (!meshes_[m].motion()) continue;
+        const auto& now = meshes_[m].vertices_world_m();
+        const auto& then = reference_mesh_vertices_m_[m];
+        for (std::size_t k = 0; k < now.size(); ++k) mesh_move2 = std::max(mesh_move2, norm_squared(now[k] - then[k]));
+    }
+    return particle_move + std::sqrt(mesh_move2) > skin_m_;
+}
+
+void World::finish_step(double dt_s)
+{
+    time_s_ += dt_s;
+    ++step_count_;
+
+    // wall reactions: sum in list order (deterministic)
+    std::fill(wall_force_N_.begin(), wall_force_N_.end(), Vec3{});
+    for (const WallContact& c : wall_contacts_)
+        wall_force_N_[static_cast<std::size_t>(c.wall)] -= c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
+
+    // surface contact records for consumers (wear)
+    records_.resize(wall_contacts_.size());
+    for (std::size_t k = 0; k < wall_contacts_.size(); ++k) {
+        const WallContact& c = wall_contacts_[k];
+        ContactRecord& r = records_[k];
+        r.point_world = c.point;
+        r.normal_world = c.normal;
+        r.normal_force_N = c.forces.normal_force_N;
+        r.tangential_force_N = c.forces.tangential_force_N;
+        r.relative_displacement_m = c.relative_displacement_m;
+        r.overlap_m = c.overlap_m;
+        r.surface_id = c.wall;
+        r.triangle_id = c.triangle;
+        r.particle_index = static_cast<std::int32_t>(c.particle);
+        r.particle_mass_kg = particles_.mass_kg[c.particle];
+    }
+    if (consumer_) consumer_(records_, time_s_, dt_s);
+
+    for (const WallContact& c : wall_contacts_) {
+        const double ratio = c.overlap_m / particles_.radius_m[c.particle];
+        if (ratio > settings_.max_overlap_ratio) {
+            const Vec3 p = particles_.position_m[c.particle];
+            throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
+                                         wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",
+                                         " by ", ratio, " of its radius (limit ", settings_.max_overlap_ratio, ") at (",
+                                         p.x, ", ", p.y, ", ", p.z, "), speed ", norm(particles_.velocity_m_per_s[c.particle]),
+                                         " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
+                                         " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall"));
+        }
+    }
+    if (max_overlap_ratio_ > settings_.max_overlap_ratio) fail_overlap();
+}
+
+std::string World::where_in_time() const
+{
+    return concat("step ", step_count_, " (t=", time_s_, " s)");
+}
+
+// ---- neighbour search ----------------------------------------------------------------------------
+
+void World::rebuild()
+{
+    const std::size_t n = particles_.size();
+    ++rebuild_count_;
+    rebuild_needed_ = false;
+    double r_max = 0.0;
+    for (double r : particles_.radius_m) r_max = std::max(r_max, r);
+    skin_m_ = settings_.skin_fraction_of_radius * r_max;
+
+    // the cell grid over the particles' bounding box; cells at least one interaction range wide
+    Vec3 lo{0.0, 0.0, 0.0}, hi{0.0, 0.0, 0.0};
+    if (n > 0) {
+        lo = hi = particles_.position_m[0];
+        for (const Vec3& p : particles_.position_m) {
+            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+    }
+    double cell = std::max(2.0 * r_max + skin_m_, 1e-12);
+    int dims[3];
+    const std::size_t max_cells = std::max<std::size_t>(64, 4 * n);
+    for (;;) {
+        std::size_t total = 1;
+        for (int a = 0; a < 3; ++a) {
+            dims[a] = static_cast<int>((hi[a] - lo[a]) / cell) + 1;
+            total *= static_cast<std::size_t>(dims[a]);
+        }
+        if (total <= max_cells) break;
+        cell *= 1.25;  // sparse, spread-out particles: coarser cells keep the grid small
+    }
+    const std::size_t cell_count = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
+    auto cell_of = [&](const Vec3& p) {
+        int c[3];
+        for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - lo[a]) / cell), 0, dims[a] - 1);
+        return static_cast<std::uint32_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
+    };
+
+    // sort particles by cell (counting sort, stable) for memory locality
+    std::vector<std::uint32_t> particle_cell(n), cell_start(cell_count + 1, 0), order(n), old_to_new(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        particle_cell[i] = cell_of(particles_.position_m[i]);
+        ++cell_start[particle_cell[i] + 1];
+    }
+    std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
+    {
+        std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+        for (std::size_t i = 0; i < n; ++i) order[fill[particle_cell[i]]++] = static_cast<std::uint32_t>(i);
+    }
+    for (std::size_t k = 0; k < n; ++k) old_to_new[order[k]] = static_cast<std::uint32_t>(k);
+    particles_.permute(order);
+
+    // carry the history of touching pairs over, renumbered and oriented so that i < j
+    struct Carried { std::uint32_t i, j; ContactHistory history; std::uint8_t touching; };
+    std::vector<Carried> carried;
+    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
+        if (!pair_touching_[k]) continue;
+        if (pair_i_[k] >= n || pair_j_[k] >= n) continue;
+        std::uint32_t a = old_to_new[pair_i_[k]], b = old_to_new[pair_j_[k]];
+        ContactHistory h = pair_history_[k];
+        if (a > b) {  // seen from the other particle: both springs change sign
+            std::swap(a, b);
+            h.tangential_spring_m = -h.tangential_spring_m;
+            h.rolling_torque_N_m = -h.rolling_torque_N_m;
+        }
+        carried.push_back({a, b, h, 1});
+    }
+    std::sort(carried.begin(), carried.end(),
+              [](const Carried& p, const Carried& q) { return p.i != q.i ? p.i < q.i : p.j < q.j; });
+
+    // new half list: j > i within range r_i + r_j + skin, cells visited in increasing index so j ascends
+    std::vector<std::vector<std::uint32_t>> thread_i(static_cast<std::size_t>(threads_)), thread_j(thread_i.size());
+#pragma omp parallel num_threads(threads_)
+    {
+        const int t = omp_get_thread_num();
+        std::size_t begin, end;
+        thread_block(n, t, threads_, begin, end);
+        auto& out_i = thread_i[static_cast<std::size_t>(t)];
+        auto& out_j = thread_j[static_cast<std::size_t>(t)];
+        for (std::size_t i = begin; i < end; ++i) {
+            const Vec3 xi = particles_.position_m[i];
+            const double ri = particles_.radius_m[i];
+            const std::uint32_t own = cell_of(xi);
+            const int cx = static_cast<int>(own % static_cast<std::uint32_t>(dims[0]));
+            const int cy = static_cast<int>((own / static_cast<std::uint32_t>(dims[0])) % static_cast<std::uint32_t>(dims[1]));
+            const int cz = static_cast<int>(own / (static_cast<std::uint32_t>(dims[0]) * static_cast<std::uint32_t>(dims[1])));
+            for (int dz = -1; dz <= 1; ++dz) {
+                const int z = cz + dz;
+                if (z < 0 || z >= dims[2]) continue;
+                for (int dy = -1; dy <= 1; ++dy) {
+                    const int y = cy + dy;
+                    if (y < 0 || y >= dims[1]) continue;
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int xcell = cx + dx;
+                        if (xcell < 0 || xcell >= dims[0]) continue;
+                        const std::uint32_t c = static_cast<std::uint32_t>((static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + xcell);
+                        if (c < own) continue;
+                        for (std::uint32_t j = std::max<std::uint32_t>(cell_start[c], static_cast<std::uint32_t>(i + 1));
+                             j < cell_start[c + 1]; ++j) {
+                            const double range = ri + particles_.radius_m[j] + skin_m_;
+                            if (norm_squared(particles_.position_m[j] - xi) < range * range) {
+                                out_i.push_back(static_cast<std::uint32_t>(i));
+                                out_j.push_back(j);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    pair_i_.clear();
+    pair_j_.clear();
+    for (std::size_t t = 0; t < thread_i.size(); ++t) {
+        pair_i_.insert(pair_i_.end(), thread_i[t].begin(), thread_i[t].end());
+        pair_j_.insert(pair_j_.end(), thread_j[t].begin(), thread_j[t].end());
+    }
+    const std::size_t pairs = pair_i_.size();
+    pair_history_.assign(pairs, ContactHistory{});
+    pair_touching_.assign(pairs, 0);
+    pair_force_.assign(pairs, Vec3{});
+    pair_torque_i_.assign(pairs, Vec3{});
+    pair_torque_j_.assign(pairs, Vec3{});
+
+    // merge the carried history into the new list (both sorted by (i, j))
+    {
+        std::size_t c = 0;
+        for (std::size_t k = 0; k < pairs && c < carried.size(); ++k) {
+            while (c < carried.size() && (carried[c].i < pair_i_[k] || (carried[c].i == pair_i_[k] && carried[c].j < pair_j_[k])))
+                ++c;  // a pair that drifted out of range has separated: its history ends
+            if (c < carried.size() && carried[c].i == pair_i_[k] && carried[c].j == pair_j_[k]) {
+                pair_history_[k] = carried[c].history;
+                pair_touching_[k] = 1;
+                ++c;
+            }
+        }
+    }
+
+    // CSR of pairs by first particle and, for the gather, by second particle
+    pair_start_.assign(n + 1, 0);
+    reverse_start_.assign(n + 1, 0);
+    for (std::size_t k = 0; k < pairs; ++k) {
+        ++pair_start_[pair_i_[k] + 1];
+        ++reverse_start_[pair_j_[k] + 1];
+    }
+    std::partial_sum(pair_start_.begin(), pair_start_.end(), pair_start_.begin());
+    std::partial_sum(reverse_start_.begin(), reverse_start_.end(), reverse_start_.begin());
+    reverse_pairs_.resize(pairs);
+    {
+        std::vector<std::uint32_t> fill(reverse_start_.begin(), reverse_start_.end() - 1);
+        for (std::size_t k = 0; k < pairs; ++k) reverse_pairs_[fill[pair_j_[k]]++] = static_cast<std::uint32_t>(k);
+    }
+
+    // wall contacts keep their history: renumber and re-sort by particle
+    for (WallContact& c : wall_contacts_) c.particle = c.particle < n ? old_to_new[c.particle] : std::uint32_t(n);
+    wall_contacts_.erase(std::remove_if(wall_contacts_.begin(), wall_contacts_.end(),
+                                        [n](const WallContact& c) { return c.particle >= n; }),
+                         wall_contacts_.end());
+    std::stable_sort(wall_contacts_.begin(), wall_contacts_.end(),
+                     [](const WallContact& a, const WallContact& b) { return a.particle < b.particle; });
+    wall_contact_start_.assign(n + 1, 0);
+    for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
+    std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
+
+    // triangles near each particle
+    build_mesh_candidates(lo, cell, dims, cell_start);
+
+    reference_position_m_ = particles_.position_m;
+    reference_mesh_vertices_m_.resize(meshes_.size());
+    for (std::size_t m = 0; m < meshes_.size(); ++m) reference_mesh_vertices_m_[m] = meshes_[m].vertices_world_m();
+}
+
+void World::build_mesh_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start)
+{
+    const std::size_t n = particles_.size();
+    candidate_start_.assign(n + 1, 0);
+    candidates_.clear();
+    if (meshes_.empty() || n == 0) return;
+    double r_max = 0.0;
+    for (double r : particles_.radius_m) r_max = std::max(r_max, r);
+    const double reach = r_max + skin_m_;
+
+    // triangles into every cell their inflated bounding box overlaps
+    const std::size_t cell_count = cell_start.size() - 1;
+    std::vector<std::uint32_t> bucket_count(cell_count + 1, 0);
+    std::vector<std::pair<std::uint32_t, MeshCandidate>> entries;
+    for (std::size_t m = 0; m < meshes_.size(); ++m) {
+        const auto& verts = meshes_[m].vertices_world_m();
+        const auto& tris = meshes_[m].mesh().triangles();
+        for (std::size_t t = 0; t < tris.size(); ++t) {
+            int c0[3], c1[3];
+            bool outside = false;
+            for (int a = 0; a < 3; ++a) {
+                const double vmin = std::min({verts[tris[t][0]][a], verts[tris[t][1]][a], verts[tris[t][2]][a]}) - reach;
+                const double vmax = std::max({verts[tris[t][0]][a], verts[tris[t][1]][a], verts[tris[t][2]][a]}) + reach;
+                const double f0 = std::floor((vmin - lo[a]) / cell), f1 = std::floor((vmax - lo[a]) / cell);
+                if (f1 < 0.0 || f0 > dims[a] - 1) { outside = true; break; }
+                c0[a] = static_cast<int>(std::max(f0, 0.0));
+                c1[a] = static_cast<int>(std::min(f1, static_cast<double>(dims[a] - 1)));
+            }
+            if (outside) continue;
+            for (int z = c0[2]; z <= c1[2]; ++z)
+                for (int y = c0[1]; y <= c1[1]; ++y)
+                    for (int x = c0[0]; x <= c1[0]; ++x) {
+                        const auto c = static_cast<std::uint32_t>((static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x);
+                        if (cell_start[c] == cell_start[c + 1]) continue;  // no particle there
+                        entries.push_back({c, {static_cast<std::uint32_t>(m), static_cast<std::uint32_t>(t)}});
+                    }
+        }
+    }
+    for (const auto& e : entries) ++bucket_count[e.first + 1];
+    std::partial_sum(bucket_count.begin(), bucket_count.end(), bucket_count.begin());
+    std::vector<MeshCandidate> bucket(entries.size());
+    {
+        std::vector<std::uint32_t> fill(bucket_count.begin(), bucket_count.end() - 1);
+        for (const auto& e : entries) bucket[fill[e.first]++] = e.second;
+    }
+
+    // each particle keeps the triangles of its own cell that lie within r + skin
+    std::vector<std::vector<MeshCandidate>> per_thread(static_cast<std::size_t>(threads_));
+    std::vector<std::uint32_t> counts(n, 0);
+#pragma omp parallel num_threads(threads_)
+    {
+        const int t = omp_get_thread_num();
+        std::size_t begin, end;
+        thread_block(n, t, threads_, begin, end);
+        auto& out = per_thread[static_cast<std::size_t>(t)];
+        for (std::size_t i = begin; i < end; ++i) {
+            const Vec3 p = particles_.position_m[i];
+            int c[3];
+            for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - lo[a]) / cell), 0, dims[a] - 1);
+            const auto cid = static_cast<std::size_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
+            const double range = particles_.radius_m[i] + skin_m_;
+            for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1]; ++k) {
+                const MeshCandidate mc = bucket[k];
+                const auto& verts = meshes_[mc.mesh].vertices_world_m();
+                const auto& tri = meshes_[mc.mesh].mesh().triangles()[mc.triangle];
+                if (meshes::closest_point_on_triangle(p, verts[tri[0]], verts[tri[1]], verts[tri[2]]).distance_squared <
+                    range * range) {
+                    out.push_back(mc);
+                    ++counts[i];
+                }
+            }
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) candidate_start_[i + 1] = candidate_start_[i] + counts[i];
+    for (const auto& v : per_thread) candidates_.insert(candidates_.end(), v.begin(), v.end());
+}
+
+// ---- forces --------------------------------------------------------------------------------------
+
+void World::compute_pair_forces(double dt_s)
+{
+    const std::size_t pairs = pair_i_.size();
+    const auto& x = particles_.position_m;
+    const auto& v = particles_.velocity_m_per_s;
+    const auto& w = particles_.angular_velocity_rad_per_s;
+    const auto& r = particles_.radius_m;
+    const auto& m = particles_.mass_kg;
+    const auto& mat = particles_.material;
+    double max_ratio = 0.0;
+
+#pragma omp parallel for schedule(static) reduction(max : max_ratio) num_threads(threads_)
+    for (std::size_t k = 0; k < pairs; ++k) {
+        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
+        const Vec3 d = x[i] - x[j];
+        const double dist2 = norm_squared(d);
+        const double rsum = r[i] + r[j];
+        if (dist2 >= rsum * rsum) {
+            if (pair_touching_[k]) {  // separated: the history of this contact ends
+                pair_touching_[k] = 0;
+                pair_history_[k] = ContactHistory{};
+            }
+            continue;
+        }
+        pair_touching_[k] = 1;
+        const double dist = std::sqrt(dist2);
+        const Vec3 n = dist > 0.0 ? d * (1.0 / dist) : Vec3{0.0, 0.0, 1.0};
+        const double overlap = rsum - dist;
+        max_ratio = std::max(max_ratio, overlap / std::min(r[i], r[j]));
+
+        // contact point halfway through the overlap; lever arms from each centre to it
+        const Vec3 arm_i = n * -(r[i] - 0.5 * overlap);
+        const Vec3 arm_j = n * (r[j] - 0.5 * overlap);
+        const MaterialIndex a = mat[i], b = mat[j];
+        const PairCoefficients& p = materials_.pair_unchecked(a, b);
+        ContactState c;
+        c.overlap_m = overlap;
+        c.normal = n;
+        c.relative_velocity_m_per_s = (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j));
+        c.relative_angular_velocity_rad_per_s = w[i] - w[j];
+        c.effective_radius_m = r[i] * r[j] / rsum;
+        c.effective_mass_kg = m[i] * m[j] / (m[i] + m[j]);
+        c.normal_stiffness_N_per_m = pair_normal_stiffness(materials_.material(a).bulk_modulus_Pa(), r[i],
+                                                           materials_.material(b).bulk_modulus_Pa(), r[j],
+                                                           p.normal_stiffness_scale);
+        const ContactForces f = linear_spring_dashpot(c, p, pair_history_[k], dt_s);
+        const Vec3 force = n * f.normal_force_N + f.tangential_force_N;
+        pair_force_[k] = force;
+        pair_torque_i_[k] = cross(arm_i, force) + f.rolling_torque_N_m;
+        pair_torque_j_[k] = cross(arm_j, -force) - f.rolling_torque_N_m;
+    }
+    max_overlap_ratio_ = max_ratio;
+}
+
+void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallContact>& out) const
+{
+    const Vec3 x = particles_.position_m[i];
+    const double r = particles_.radius_m[i];
+
+    struct Hit {
+        std::int32_t wall, triangle;
+        meshes::Feature feature;
+        std::uint32_t feature_id;
+        Vec3 point, normal;
+        double overlap;
+    };
+    Hit hits[32];
+    int hit_count = 0;
+    auto push_hit = [&](const Hit& h) {
+        if (hit_count == 32)
+            throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[i],
+                                         " touches more than 32 wall features at once; the mesh is far finer than the particle"));
+        hits[hit_count++] = h;
+    };
+
+    // analytic planes
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        if (walls_[w].is_mesh) continue;
+        const PlaneWall& pl = planes_[static_cast<std::size_t>(walls_[w].index)];
+        const double dist = dot(x - pl.point_m, pl.normal);
+        if (dist < r) push_hit({static_cast<std::int32_t>(w), -1, meshes::Feature::Face, 0, x - pl.normal * dist, pl.normal, r - dist});
+    }
+
+    // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
+    const int first_mesh_hit = hit_count;
+    for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1]; ++k) {
+        const MeshCandidate mc = candidates_[k];
+        const MeshWall& mw = meshes_[mc.mesh];
+        const auto& tri = mw.mesh().triangles()[mc.triangle];
+        const auto& verts = mw.vertices_world_m();
+        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(x, verts[tri[0]], verts[tri[1]], verts[tri[2]]);
+        if (cp.distance_squared >= r * r) continue;
+        const double dist = std::sqrt(cp.distance_squared);
+        Vec3 normal = dist > 1e-12 * r ? (x - cp.point) * (1.0 / dist) : mw.normal_world(mc.triangle);
+        std::uint32_t feature_id = mc.triangle;
+        if (cp.feature == meshes::Feature::Edge) feature_id = mw.mesh().triangle_edges(mc.triangle)[static_cast<std::size_t>(cp.local_index)];
+        if (cp.feature == meshes::Feature::Vertex) feature_id = tri[static_cast<std::size_t>(cp.local_index)];
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, cp.point, normal, r - dist});
+    }
+
+    // one contact per touched feature: an edge or vertex that belongs to a touched face (or a vertex
+    // of a touched edge) of the same mesh is part of that contact, and a feature shared by several
+    // triangles counts once
+    bool keep[32];
+    for (int a = 0; a < hit_count; ++a) keep[a] = true;
+    for (int a = first_mesh_hit; a < hit_count; ++a) {
+        const Hit& h = hits[a];
+        if (h.feature == meshes::Feature::Face) continue;
+        const meshes::TriangleMesh& mesh = meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(h.wall)].index)].mesh();
+        for (int b = first_mesh_hit; b < hit_count && keep[a]; ++b) {
+            if (b == a || hits[b].wall != h.wall) continue;
+            const Hit& o = hits[b];
+            if (o.feature == h.feature && o.feature_id == h.feature_id) {
+                keep[a] = b > a;  // duplicate: the first one stays
+                continue;
+            }
+            if (h.feature == meshes::Feature::Edge && o.feature == meshes::Feature::Face) {
+                const auto& edges = mesh.triangle_edges(static_cast<std::size_t>(o.triangle));
+                if (edges[0] == h.feature_id || edges[1] == h.feature_id || edges[2] == h.feature_id) keep[a] = false;
+            }
+            if (h.feature == meshes::Feature::Vertex) {
+                if (o.feature == meshes::Feature::Face) {
+                    const auto& t = mesh.triangles()[static_cast<std::size_t>(o.triangle)];
+                    if (t[0] == h.feature_id || t[1] == h.feature_id || t[2] == h.feature_id) keep[a] = false;
+                } else if (o.feature == meshes::Feature::Edge) {
+                    const auto& e = mesh.edge_vertices(o.feature_id);
+                    if (e[0] == h.feature_id || e[1] == h.feature_id) keep[a] = false;
+                }
+            }
+        }
+    }
+
+    // forces, with history matched to last step's contact of the same wall whose normal is closest
+    const std::uint32_t old_begin = i < wall_contact_start_.size() - 1 ? wall_contact_start_[i] : 0;
+    const std::uint32_t old_end = i < wall_contact_start_.size() - 1 ? wall_contact_start_[i + 1] : 0;
+    bool used[32] = {};
+    const Vec3 v = particles_.velocity_m_per_s[i];
+    const Vec3 w = particles_.angular_velocity_rad_per_s[i];
+    for (int a = 0; a < hit_count; ++a) {
+        if (!keep[a]) continue;
+        const Hit& h = hits[a];
+        WallContact c;
+        c.particle = i;
+        c.wall = h.wall;
+        c.triangle = h.triangle;
+        c.normal = h.normal;
+        c.point = h.point;
+        c.overlap_m = h.overlap;
+        int best = -1;
+        double best_dot = 0.9;  // within about 25 degrees: the same contact moving over the surface
+        for (std::uint32_t k = old_begin; k < old_end; ++k) {
+            const WallContact& old = wall_contacts_[k];
+            const int slot = static_cast<int>(k - old_begin);
+            if (old.wall != h.wall || slot >= 32 || used[slot]) continue;
+            const double d = dot(old.normal, h.normal);
+            if (d > best_dot) { best_dot = d; best = slot; }
+        }
+        if (best >= 0) {
+            used[best] = true;
+            c.history = wall_contacts_[old_begin + static_cast<std::uint32_t>(best)].history;
+        }
+
+        const WallRef& ref = walls_[static_cast<std::size_t>(h.wall)];
+        const MaterialIndex wall_material = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].material()
+                                                        : planes_[static_cast<std::size_t>(ref.index)].material;
+        const Vec3 wall_velocity = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].velocity_at(h.point) : Vec3{};
+        const Vec3 wall_spin = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].angular_velocity_rad_per_s() : Vec3{};
+        const PairCoefficients& p = materials_.pair_unchecked(particles_.material[i], wall_material);
+        const Vec3 arm = h.point - x;
+        ContactState s;
+        s.overlap_m = h.overlap;
+        s.normal = h.normal;
+        s.relative_velocity_m_per_s = v + cross(w, arm) - wall_velocity;
+        s.relative_angular_velocity_rad_per_s = w - wall_spin;
+        s.effective_radius_m = r;
+        s.effective_mass_kg = particles_.mass_kg[i];
+        s.normal_stiffness_N_per_m = wall_normal_stiffness(materials_.material(particles_.material[i]).bulk_modulus_Pa(),
+                                                           r, p.normal_stiffness_scale);
+        c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
+        c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
+        out.push_back(c);
+    }
+}
+
+void World::compute_wall_contacts(double dt_s)
+{
+    const std::size_t n = particles_.size();
+    const bool any_wall = !walls_.empty();
+#pragma omp parallel num_threads(threads_)
+    {
+        const int t = omp_get_thread_num();
+        std::size_t begin, end;
+        thread_block(n, t, threads_, begin, end);
+        auto& out = thread_wall_contacts_[static_cast<std::size_t>(t)];
+        out.clear();
+        if (any_wall)
+            for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, out);
+    }
+    wall_contacts_.clear();
+    for (const auto& v : thread_wall_contacts_) wall_contacts_.insert(wall_contacts_.end(), v.begin(), v.end());
+    wall_contact_start_.assign(n + 1, 0);
+    for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
+    std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
+}
+
+void World::gather_forces()
+{
+    const std::size_t n = particles_.size();
+    const Vec3 g = settings_.gravity_m_per_s2;
+    int bad = -1;
+#pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : bad)
+    for (std::size_t i = 0; i < n; ++i) {
+        Vec3 f = g * particles_.mass_kg[i];
+        Vec3 torque{};
+        for (std::uint32_t k = pair_start_[i]; k < pair_start_[i + 1]; ++k)
+            if (pair_touching_[k]) {
+                f += pair_force_[k];
+                torque += pair_torque_i_[k];
+            }
+        for (std::uint32_t q = reverse_start_[i]; q < reverse_start_[i + 1]; ++q) {
+            const std::uint32_t k = reverse_pairs_[q];
+            if (pair_touching_[k]) {
+                f -= pair_force_[k];
+                torque += pair_torque_j_[k];
+            }
+        }
+        for (std::uint32_t k = wall_contact_start_[i]; k < wall_contact_start_[i + 1]; ++k) {
+            const WallContact& c = wall_contacts_[k];
+            const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
+            f += force;
+            torque += cross(c.point - particles_.position_m[i], force) + c.forces.rolling_torque_N_m;
+        }
+        particles_.force_N[i] = f;
+        particles_.torque_N_m[i] = torque;
+        if (!is_finite(f) || !is_finite(torque) || !is_finite(particles_.position_m[i])) bad = std::max(bad, static_cast<int>(i));
+    }
+    if (bad >= 0) {
+        const auto i = static_cast<std::size_t>(bad);
+        throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[i], " has a non-finite force or position (x = ",
+                                     particles_.position_m[i].x, ", ", particles_.position_m[i].y, ", ",
+                                     particles_.position_m[i].z, "); step_s = ", step_s_,
+                                     " s; try step_s <= ", 0.5 * step_s_, " s (stable limit ", stable_step_limit_s(), " s)"));
+    }
+}
+
+[[noreturn]] void World::fail_overlap() const
+{
+    // find the worst pair for the diagnosis
+    std::size_t worst = 0;
+    double worst_ratio = -1.0;
+    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
+        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
+        const double ov = particles_.radius_m[i] + particles_.radius_m[j] - norm(particles_.position_m[i] - particles_.position_m[j]);
+        const double ratio = ov / std::min(particles_.radius_m[i], particles_.radius_m[j]);
+        if (ratio > worst_ratio) { worst_ratio = ratio; worst = k; }
+    }
+    const std::uint32_t i = pair_i_[worst], j = pair_j_[worst];
+    const Vec3 p = particles_.position_m[i];
+    throw SimulationError(concat(where_in_time(), ": particles ", particles_.id[i], " and ", particles_.id[j],
+                                 " overlap by ", worst_ratio, " of the smaller radius (limit ", settings_.max_overlap_ratio,
+                                 ") near (", p.x, ", ", p.y, ", ", p.z, "); relative speed ",
+                                 norm(particles_.velocity_m_per_s[i] - particles_.velocity_m_per_s[j]),
+                                 " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
+                                 " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or check for particles created inside each other"));
+}
+
+void World::check_initial_overlaps() const
+{
+    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
+        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
+        const double smaller = std::min(particles_.radius_m[i], particles_.radius_m[j]);
+        const double ov = particles_.radius_m[i] + particles_.radius_m[j] - norm(particles_.position_m[i] - particles_.position_m[j]);
+        if (ov > settings_.initial_overlap_tolerance * smaller)
+            throw InputError(concat("initial particles ", particles_.id[i], " and ", particles_.id[j], " overlap by ", ov,
+                                    " m = ", ov / smaller, " of the smaller radius; at most ",
+                                    settings_.initial_overlap_tolerance, " (initial_overlap_tolerance) is accepted"));
+    }
+}
+
+// ---- observables ---------------------------------------------------------------------------------
+
+std::size_t World::pair_contact_count() const
+{
+    std::size_t count = 0;
+    for (std::uint8_t t : pair_touching_) count += t;
+    return count;
+}
+
+std::vector<PairContactView> World::pair_contacts() const
+{
+    std::vector<PairContactView> out;
+    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
+        if (!pair_touching_[k]) continue;
+        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
+        PairContactView c;
+        c.id_a = particles_.id[i];
+        c.id_b = particles_.id[j];
+        c.overlap_m = particles_.radius_m[i] + particles_.radius_m[j] - norm(particles_.position_m[i] - particles_.position_m[j]);
+        c.history = pair_history_[k];
+        if (c.id_a > c.id_b) {
+            std::swap(c.id_a, c.id_b);
+            c.history.tangential_spring_m = -c.history.tangential_spring_m;
+            c.history.rolling_torque_N_m = -c.history.rolling_torque_N_m;
+        }
+        out.push_back(c);
+    }
+    std::sort(out.begin(), out.end(), [](const PairContactView& a, const PairContactView& b) {
+        return a.id_a != b.id_a ? a.id_a < b.id_a : a.id_b < b.id_b;
+    });
+    return out;
+}
+
+double World::kinetic_energy_J() const
+{
+    double e = 0.0;
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+        e += 0.5 * particles_.mass_kg[i] * norm_squared(particles_.velocity_m_per_s[i]) +
+             0.5 / particles_.inverse_inertia_per_kg_m2[i] * norm_squared(particles_.angular_velocity_rad_per_s[i]);
+    return e;
+}
+
+double World::gravitational_potential_energy_J() const
+{
+    double e = 0.0;
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+        e -= particles_.mass_kg[i] * dot(settings_.gravity_m_per_s2, particles_.position_m[i]);
+    return e;
+}
+
+Vec3 World::linear_momentum_kg_m_per_s() const
+{
+    Vec3 p{};
+    for (std::size_t i = 0; i < particles_.size(); ++i) p += particles_.velocity_m_per_s[i] * particles_.mass_kg[i];
+    return p;
+}
+
+Vec3 World::angular_momentum_kg_m2_per_s() const
+{
+    Vec3 l{};
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+        l += cross(particles_.position_m[i], particles_.velocity_m_per_s[i] * particles_.mass_kg[i]) +
+             particles_.angular_velocity_rad_per_s[i] * (1.0 / particles_.inverse_inertia_per_kg_m2[i]);
+    return l;
+}
+
+double World::total_mass_kg() const
+{
+    double m = 0.0;
+    for (double mi : particles_.mass_kg) m += mi;
+    return m;
+}
+
+}  // namespace dipper::dem

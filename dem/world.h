@@ -1,0 +1,171 @@
+// The spherical DEM: particles, walls, neighbour search, contact forces and time integration.
+#pragma once
+
+#include "core/contact_record.h"
+#include "core/vec3.h"
+#include "dem/contact_law.h"
+#include "dem/material.h"
+#include "dem/particle_store.h"
+#include "dem/walls.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dipper::dem {
+
+/// Settings of a DEM world; validated when the world is made.
+struct WorldSettings {
+    Vec3 gravity_m_per_s2{0.0, 0.0, -9.81};
+    /// Time step. 0 picks kDefaultStepFactor x reference step; a value above the stable limit
+    /// (kStableStepFactor x reference step) is refused when the simulation starts.
+    double step_s = 0.0;
+    /// Verlet skin as a fraction of the largest particle radius: pairs closer than r1 + r2 + skin are
+    /// listed, and the list is rebuilt when a particle has moved half the skin.
+    double skin_fraction_of_radius = 0.3;
+    int threads = 1;                         ///< OpenMP threads; 0 takes OMP_NUM_THREADS / all cores
+    double max_overlap_ratio = 0.5;          ///< stop with a diagnosis when overlap / smaller radius exceeds it
+    double initial_overlap_tolerance = 0.01; ///< initial overlaps above this fraction of the smaller radius are refused
+};
+
+/// Reference time step sqrt(m / K) (thesis: dt = c_dt sqrt(m/k)) and its factors.
+/// The stable limit is 0.2 x reference: with several contacts per particle and damping up to critical,
+/// velocity Verlet needs omega dt well below 1 (docs/contact_model.md gives the derivation).
+inline constexpr double kStableStepFactor = 0.2;
+inline constexpr double kDefaultStepFactor = 0.15;
+
+/// One touching sphere pair, for inspection and output.
+struct PairContactView {
+    std::uint32_t id_a = 0, id_b = 0;  ///< stable particle ids
+    double overlap_m = 0.0;
+    ContactHistory history;            ///< as seen from particle a
+};
+
+/// A spherical DEM world. Not thread-safe itself; uses OpenMP threads inside step().
+class World {
+public:
+    World(MaterialTable materials, WorldSettings settings);
+
+    // ---- building ------------------------------------------------------------------------------
+    /// Adds a particle (validated); returns its stable id. `where` names the source for errors.
+    std::uint32_t add_particle(const ParticleSpawn& spawn, const std::string& where = "add_particle");
+    /// Adds an infinite plane through point_m with the given normal (particles on the normal's side).
+    int add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex material, const std::string& name);
+    /// Adds a triangle mesh wall; with a motion it moves by itself, without it stays where set_mesh_pose puts it.
+    int add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std::string& name,
+                 std::optional<PrescribedMotion> motion = std::nullopt);
+    /// Moves a mesh wall rigidly (used by code that drives machine parts); takes effect for the next step.
+    void set_mesh_pose(int wall_id, const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_m,
+                       const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s);
+    /// Receives every sphere-wall contact of each step (see core/contact_record.h).
+    void set_contact_consumer(ContactConsumer consumer) { consumer_ = std::move(consumer); }
+
+    // ---- running -------------------------------------------------------------------------------
+    /// Advances one step: half kick and drift, walls moved, neighbour lists refreshed if needed,
+    /// forces, second half kick. Throws SimulationError with a diagnosis if the state blows up.
+    void step();
+    /// Advances n steps.
+    void run_steps(std::uint64_t n);
+    /// Makes the next step rebuild the neighbour lists (history is carried over as always).
+    void request_rebuild() { rebuild_needed_ = true; }
+
+    // ---- time step -----------------------------------------------------------------------------
+    /// sqrt(m_i / K_max,i) minimised over particles, K_max,i the stiffest contact particle i can have.
+    double reference_step_s() const;
+    double stable_step_limit_s() const { return kStableStepFactor * reference_step_s(); }
+    double step_s() const;  ///< the step in use (the default is resolved when particles exist)
+
+    // ---- state ---------------------------------------------------------------------------------
+    const ParticleStore& particles() const { return particles_; }
+    ParticleStore& particles() { return particles_; }
+    const MaterialTable& materials() const { return materials_; }
+    const WorldSettings& settings() const { return settings_; }
+    double time_s() const { return time_s_; }
+    std::uint64_t step_count() const { return step_count_; }
+    std::uint64_t rebuild_count() const { return rebuild_count_; }
+    std::size_t wall_count() const { return walls_.size(); }
+    const std::string& wall_name(int wall_id) const;
+    const MeshWall& mesh_wall(int wall_id) const;
+    const PlaneWall& plane_wall(int wall_id) const;
+    bool is_mesh(int wall_id) const;
+
+    /// Total force the particles exert on a wall during the last step, N (deterministic sum).
+    Vec3 wall_force_N(int wall_id) const;
+    /// Surface contacts of the last step.
+    const std::vector<ContactRecord>& last_contact_records() const { return records_; }
+    std::size_t pair_contact_count() const;          ///< touching sphere pairs in the last step
+    std::size_t wall_contact_count() const { return wall_contacts_.size(); }
+    std::size_t neighbour_pair_count() const { return pair_i_.size(); }
+    double max_overlap_ratio() const { return max_overlap_ratio_; }  ///< largest overlap / smaller radius, last step
+    std::vector<PairContactView> pair_contacts() const;
+    double kinetic_energy_J() const;                 ///< translational + rotational
+    double gravitational_potential_energy_J() const; ///< -m g . x summed
+    Vec3 linear_momentum_kg_m_per_s() const;
+    Vec3 angular_momentum_kg_m2_per_s() const;        ///< about the origin, including spin
+    double total_mass_kg() const;
+    int threads() const { return threads_; }
+
+private:
+    struct WallRef { bool is_mesh; int index; };
+    struct WallContact {
+        std::uint32_t particle;
+        std::int32_t wall, triangle;
+        Vec3 normal, point, relative_displacement_m;
+        double overlap_m;
+        ContactHistory history;
+        ContactForces forces;
+    };
+    struct MeshCandidate { std::uint32_t mesh, triangle; };
+
+    void prepare();
+    void validate_step();
+    void check_initial_overlaps() const;
+    void move_prescribed_meshes(double t_end_s, double dt_s);
+    bool needs_rebuild() const;
+    void rebuild();
+    void build_mesh_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
+    void evaluate_forces(double dt_s);
+    void compute_pair_forces(double dt_s);
+    void compute_wall_contacts(double dt_s);
+    void find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallContact>& out) const;
+    void gather_forces();
+    void finish_step(double dt_s);
+    [[noreturn]] void fail_overlap() const;
+    std::string where_in_time() const;
+
+    MaterialTable materials_;
+    WorldSettings settings_;
+    int threads_ = 1;
+    ParticleStore particles_;
+    std::vector<PlaneWall> planes_;
+    std::vector<MeshWall> meshes_;
+    std::vector<WallRef> walls_;
+    std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
+    ContactConsumer consumer_;
+
+    double time_s_ = 0.0, step_s_ = 0.0;
+    std::uint64_t step_count_ = 0, rebuild_count_ = 0;
+    bool prepared_ = false, rebuild_needed_ = true, step_checked_ = false;
+
+    // neighbour list: pairs (i < j) sorted by i then j; per-pair history and force slots
+    std::vector<std::uint32_t> pair_i_, pair_j_, pair_start_, reverse_start_, reverse_pairs_;
+    std::vector<ContactHistory> pair_history_;
+    std::vector<std::uint8_t> pair_touching_;
+    std::vector<Vec3> pair_force_, pair_torque_i_, pair_torque_j_;
+    std::vector<Vec3> reference_position_m_;
+    std::vector<std::vector<Vec3>> reference_mesh_vertices_m_;
+    double skin_m_ = 0.0;
+
+    // sphere-wall contacts of the last step, sorted by particle, and mesh triangle candidates
+    std::vector<WallContact> wall_contacts_;
+    std::vector<std::uint32_t> wall_contact_start_;
+    std::vector<std::uint32_t> candidate_start_;
+    std::vector<MeshCandidate> candidates_;
+    std::vector<std::vector<WallContact>> thread_wall_contacts_;
+    std::vector<Vec3> wall_force_N_;
+    std::vector<ContactRecord> records_;
+    double max_overlap_ratio_ = 0.0;
+};
+
+}  // namespace dipper::dem

@@ -1,0 +1,18 @@
+// Reading triangle meshes from files (STL, OBJ, PLY and the other formats assimp reads).
+#pragma once
+
+#include "meshes/triangle_mesh.h"
+
+#include <string>
+
+namespace dipper::meshes {
+
+/// Loads every triangle of every mesh in the file into one TriangleMesh, identical vertices merged,
+/// coordinates multiplied by `scale` (1 for files in metres, 0.001 for millimetres).
+/// Throws InputError naming the file for a missing, unreadable or empty file and for degenerate triangles.
+TriangleMesh load_triangle_mesh(const std::string& path, double scale = 1.0);
+
+/// Writes an ASCII STL file (used to export generated geometry and by tests).
+void write_stl(const TriangleMesh& mesh, const std::string& path, const std::string& solid_name = "dipper");
+
+}  // namespace dipper::meshes

@@ -1,0 +1,79 @@
+// Triangle surface meshes: storage, topology (shared edges and vertices), validation, and the exact
+// point-to-triangle query that sphere contacts use.
+#pragma once
+
+#include "core/vec3.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dipper::meshes {
+
+/// Which feature of a triangle holds the closest point: its interior, one edge, or one vertex.
+enum class Feature : std::uint8_t { Face, Edge, Vertex };
+
+/// Closest point on one triangle to a query point, with the feature it lies on.
+struct ClosestPoint {
+    Vec3 point;
+    double distance_squared = 0.0;
+    Feature feature = Feature::Face;
+    int local_index = 0;  ///< edge 0..2 (v0v1, v1v2, v2v0) or vertex 0..2 of the triangle; unused for Face
+};
+
+/// Exact closest point on triangle (a, b, c) to p, by Voronoi regions of the vertices, edges and face.
+ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// A triangle surface mesh in its own (body) frame. Vertices are shared between triangles; edges are
+/// numbered once however many triangles share them, so that contacts can be made unique per feature.
+class TriangleMesh {
+public:
+    TriangleMesh() = default;
+    /// Builds topology and validates: indices in range, finite coordinates, no triangle with area below
+    /// `min_area_m2` (degenerate). `source` names where the data came from, for error messages.
+    TriangleMesh(std::vector<Vec3> vertices_m, std::vector<std::array<std::uint32_t, 3>> triangles,
+                 const std::string& source, double min_area_m2 = 1e-14);
+
+    std::size_t vertex_count() const { return vertices_m_.size(); }
+    std::size_t triangle_count() const { return triangles_.size(); }
+    std::size_t edge_count() const { return edge_vertices_.size(); }
+    const std::vector<Vec3>& vertices_m() const { return vertices_m_; }
+    const std::vector<std::array<std::uint32_t, 3>>& triangles() const { return triangles_; }
+    /// Global edge ids of triangle t's edges (v0v1, v1v2, v2v0).
+    const std::array<std::uint32_t, 3>& triangle_edges(std::size_t t) const { return triangle_edges_[t]; }
+    /// The two vertex ids of edge e.
+    const std::array<std::uint32_t, 2>& edge_vertices(std::size_t e) const { return edge_vertices_[e]; }
+    /// Unit normal of triangle t (right-hand rule on its vertex order), body frame.
+    const Vec3& triangle_normal(std::size_t t) const { return normals_[t]; }
+    double triangle_area_m2(std::size_t t) const { return areas_m2_[t]; }
+    double total_area_m2() const;
+    const std::string& source() const { return source_; }
+
+    /// Minimum and maximum corner of the axis-aligned bounding box, body frame.
+    Vec3 bounds_min_m() const;
+    Vec3 bounds_max_m() const;
+
+    /// True if the point lies inside the closed surface (ray parity along +x, with a tie-breaking
+    /// perturbation). Only meaningful for closed meshes.
+    bool contains(const Vec3& point_m) const;
+    /// Smallest distance from the point to the surface.
+    double distance_m(const Vec3& point_m) const;
+
+private:
+    std::vector<Vec3> vertices_m_;
+    std::vector<std::array<std::uint32_t, 3>> triangles_;
+    std::vector<std::array<std::uint32_t, 3>> triangle_edges_;
+    std::vector<std::array<std::uint32_t, 2>> edge_vertices_;
+    std::vector<Vec3> normals_;
+    std::vector<double> areas_m2_;
+    std::string source_;
+};
+
+/// Axis-aligned box as a closed mesh of 12 outward-facing triangles.
+TriangleMesh make_box_mesh(const Vec3& min_corner_m, const Vec3& max_corner_m);
+/// Flat rectangle in the z = 0 plane of its frame, [0, size_x] x [0, size_y], split into nx x ny cells
+/// of two triangles each, normal +z.
+TriangleMesh make_plate_mesh(double size_x_m, double size_y_m, int nx, int ny);
+
+}  // namespace dipper::meshes

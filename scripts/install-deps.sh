@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs the Debian packages dipper needs to build, test and report; skips what is present.
+# Usage: scripts/install-deps.sh        (needs root or sudo for apt-get)
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libassimp-dev        # mesh files (STL, OBJ, PLY)
+  catch2               # unit and analytic tests (v2.13)
+  libbenchmark-dev     # micro-benchmarks
+  libomp-dev           # OpenMP runtime headers for clang users; g++ ships libgomp
+  python3 python3-vtk9 # tests read our VTK output with the real VTK reader
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
