@@ -206,7 +206,8 @@ std::size_t Pourer::update(World& world)
         std::shuffle(radii_.begin(), radii_.end(), random_);
     }
     const double due_kg = mass_flow_kg_per_s_ * (world.time_s() - start_time_s_);
-    if (done() || poured_mass_kg_ >= due_kg) return 0;
+    // particle k enters once the flow has delivered the mass poured before it, so the first enters at once
+    if (done() || poured_mass_kg_ > due_kg) return 0;
 
     const Vec3 lo = region_.bounds_min_m(), hi = region_.bounds_max_m();
     double r_max = 0.0;
@@ -216,7 +217,7 @@ std::size_t Pourer::update(World& world)
     std::uniform_real_distribution<double> ux(lo.x, hi.x), uy(lo.y, hi.y), uz(lo.z, hi.z);
     const double density = world.materials().material(material_).density_kg_per_m3;
     std::size_t added = 0;
-    while (!done() && poured_mass_kg_ < due_kg) {
+    while (!done() && poured_mass_kg_ <= due_kg) {
         const double r = radii_[next_];
         bool placed = false;
         for (int attempt = 0; attempt < 200 && !placed; ++attempt) {

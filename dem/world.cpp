@@ -675,35 +675,31 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallCon
         push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, cp.point, normal, r - dist});
     }
 
-    // one contact per touched feature: an edge or vertex that belongs to a touched face (or a vertex
-    // of a touched edge) of the same mesh is part of that contact, and a feature shared by several
-    // triangles counts once
+    // One contact per touched feature. A face hit always counts. An edge or vertex hit counts only if no
+    // triangle that shares that edge or vertex is strictly closer (then the feature itself is the
+    // closest point of its neighbourhood: a convex edge or corner), and a feature shared by several
+    // triangles counts once. Every triangle closer than a hit is itself a hit (it lies within r), so
+    // the check over the hits is exact.
     bool keep[32];
     for (int a = 0; a < hit_count; ++a) keep[a] = true;
     for (int a = first_mesh_hit; a < hit_count; ++a) {
         const Hit& h = hits[a];
         if (h.feature == meshes::Feature::Face) continue;
         const meshes::TriangleMesh& mesh = meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(h.wall)].index)].mesh();
+        const double tolerance = 1e-9 * r;
         for (int b = first_mesh_hit; b < hit_count && keep[a]; ++b) {
             if (b == a || hits[b].wall != h.wall) continue;
             const Hit& o = hits[b];
             if (o.feature == h.feature && o.feature_id == h.feature_id) {
-                keep[a] = b > a;  // duplicate: the first one stays
+                if (b < a) keep[a] = false;  // the same feature seen from another triangle: the first one stays
                 continue;
             }
-            if (h.feature == meshes::Feature::Edge && o.feature == meshes::Feature::Face) {
-                const auto& edges = mesh.triangle_edges(static_cast<std::size_t>(o.triangle));
-                if (edges[0] == h.feature_id || edges[1] == h.feature_id || edges[2] == h.feature_id) keep[a] = false;
-            }
-            if (h.feature == meshes::Feature::Vertex) {
-                if (o.feature == meshes::Feature::Face) {
-                    const auto& t = mesh.triangles()[static_cast<std::size_t>(o.triangle)];
-                    if (t[0] == h.feature_id || t[1] == h.feature_id || t[2] == h.feature_id) keep[a] = false;
-                } else if (o.feature == meshes::Feature::Edge) {
-                    const auto& e = mesh.edge_vertices(o.feature_id);
-                    if (e[0] == h.feature_id || e[1] == h.feature_id) keep[a] = false;
-                }
-            }
+            const auto& tri = mesh.triangles()[static_cast<std::size_t>(o.triangle)];
+            const auto& edges = mesh.triangle_edges(static_cast<std::size_t>(o.triangle));
+            const bool shares = h.feature == meshes::Feature::Edge
+                                    ? (edges[0] == h.feature_id || edges[1] == h.feature_id || edges[2] == h.feature_id)
+                                    : (tri[0] == h.feature_id || tri[1] == h.feature_id || tri[2] == h.feature_id);
+            if (shares && o.overlap > h.overlap + tolerance) keep[a] = false;
         }
     }
 

@@ -6,7 +6,9 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <array>
 #include <filesystem>
+#include <map>
 #include <fstream>
 
 namespace dipper::meshes {
@@ -25,19 +27,26 @@ TriangleMesh load_triangle_mesh(const std::string& path, double scale)
         throw InputError(concat("mesh file '", path, "' could not be read: ", importer.GetErrorString()));
     if (scene->mNumMeshes == 0) throw InputError(concat("mesh file '", path, "' contains no mesh"));
 
+    // Vertices at exactly the same position are welded: formats such as STL store every facet's corners
+    // separately (and assimp keeps them apart when their normals differ), but contacts need the shared
+    // edges and vertices.
     std::vector<Vec3> vertices;
     std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::map<std::array<double, 3>, std::uint32_t> welded;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh* mesh = scene->mMeshes[m];
-        const auto base = static_cast<std::uint32_t>(vertices.size());
+        std::vector<std::uint32_t> index(mesh->mNumVertices);
         for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
             const aiVector3D& p = mesh->mVertices[v];
-            vertices.push_back({p.x * scale, p.y * scale, p.z * scale});
+            const std::array<double, 3> key{p.x * scale, p.y * scale, p.z * scale};
+            auto [it, inserted] = welded.try_emplace(key, static_cast<std::uint32_t>(vertices.size()));
+            if (inserted) vertices.push_back({key[0], key[1], key[2]});
+            index[v] = it->second;
         }
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
             if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-            triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+            triangles.push_back({index[face.mIndices[0]], index[face.mIndices[1]], index[face.mIndices[2]]});
         }
     }
     if (triangles.empty()) throw InputError(concat("mesh file '", path, "' contains no triangles"));
