@@ -65,6 +65,33 @@ inline Vec3 rotate_into_tangent_plane(const Vec3& v, const Vec3& n)
     return projected * std::sqrt(old_len2 / new_len2);
 }
 
+/// Everything about a contact that does not change while the two bodies keep their sizes and materials:
+/// stiffnesses and damping coefficients of eqs. 3-8. Computed once per distinct pair of particle kinds.
+struct ContactConstants {
+    double normal_stiffness_N_per_m = 0.0;        ///< Kn (eq. 4)
+    double normal_damping_N_s_per_m = 0.0;        ///< c_n = D_n 2 sqrt(m* Kn) (eq. 6)
+    double tangential_stiffness_N_per_m = 0.0;    ///< Kt = C_tan Kn
+    double tangential_damping_N_s_per_m = 0.0;    ///< c_t = D_t 2 sqrt(m* Kt)
+    double rolling_stiffness_N_m_per_rad = 0.0;   ///< k_r = 2.25 Kn mu_roll^2 R*^2
+    double rolling_limit_m = 0.0;                 ///< mu_roll R*: |Mr| <= this x Fn (eq. 8)
+    double friction = 0.0;                        ///< mu (eq. 7)
+};
+
+inline ContactConstants contact_constants(double kn_N_per_m, double effective_mass_kg, double effective_radius_m,
+                                          const PairCoefficients& p)
+{
+    ContactConstants k;
+    const double critical = 2.0 * std::sqrt(effective_mass_kg * kn_N_per_m);
+    k.normal_stiffness_N_per_m = kn_N_per_m;
+    k.normal_damping_N_s_per_m = p.normal_damping_ratio * critical;
+    k.tangential_stiffness_N_per_m = p.tangential_stiffness_scale * kn_N_per_m;
+    k.tangential_damping_N_s_per_m = p.tangential_damping_ratio * critical * std::sqrt(p.tangential_stiffness_scale);
+    k.rolling_stiffness_N_m_per_rad = rolling_stiffness(kn_N_per_m, p.rolling_friction, effective_radius_m);
+    k.rolling_limit_m = p.rolling_friction * effective_radius_m;
+    k.friction = p.friction;
+    return k;
+}
+
 /// The linear spring-dashpot law with Coulomb friction and rolling resistance.
 ///
 /// Normal (eq. 3, 6): Fn = max(0, Kn delta - c_n v_n), c_n = D_n 2 sqrt(m* Kn). The clamp at zero means
@@ -75,27 +102,28 @@ inline Vec3 rotate_into_tangent_plane(const Vec3& v, const Vec3& n)
 /// sliding dissipates and never stores more than the Coulomb limit (eq. 7).
 /// Rolling (eq. 8): Mr -= k_r omega_roll dt, |Mr| <= mu_roll R* Fn; omega_roll is the relative angular
 /// velocity in the tangent plane (twisting is not resisted).
-inline ContactForces linear_spring_dashpot(const ContactState& c, const PairCoefficients& p, ContactHistory& h,
-                                           double dt_s)
+/// Both springs are carried into the current tangent plane each step (rotate_into_tangent_plane).
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline ContactForces linear_spring_dashpot(double overlap_m, const Vec3& n, const Vec3& relative_velocity_m_per_s,
+                                           const Vec3& relative_angular_velocity_rad_per_s, const ContactConstants& k,
+                                           ContactHistory& h, double dt_s)
 {
     ContactForces out;
-    const Vec3& n = c.normal;
-    const double kn = c.normal_stiffness_N_per_m;
-    const double critical_n = 2.0 * std::sqrt(c.effective_mass_kg * kn);
 
     // normal: spring and dashpot, never attractive
-    const double vn = dot(c.relative_velocity_m_per_s, n);
-    const double fn = kn * c.overlap_m - p.normal_damping_ratio * critical_n * vn;
+    const double vn = dot(relative_velocity_m_per_s, n);
+    const double fn = k.normal_stiffness_N_per_m * overlap_m - k.normal_damping_N_s_per_m * vn;
     out.normal_force_N = fn > 0.0 ? fn : 0.0;
 
     // tangential: history spring in the current tangent plane, dashpot, Coulomb limit
-    const Vec3 vt = c.relative_velocity_m_per_s - n * vn;
-    const double kt = p.tangential_stiffness_scale * kn;
-    const double ct = p.tangential_damping_ratio * critical_n * std::sqrt(p.tangential_stiffness_scale);
+    const Vec3 vt = relative_velocity_m_per_s - n * vn;
+    const double kt = k.tangential_stiffness_N_per_m, ct = k.tangential_damping_N_s_per_m;
     h.tangential_spring_m = rotate_into_tangent_plane(h.tangential_spring_m, n) + vt * dt_s;
     Vec3 ft = h.tangential_spring_m * (-kt) - vt * ct;
     const double ft2 = norm_squared(ft);
-    const double limit = p.friction * out.normal_force_N;
+    const double limit = k.friction * out.normal_force_N;
     if (ft2 > limit * limit) {
         ft = ft2 > 0.0 ? ft * (limit / std::sqrt(ft2)) : Vec3{};
         h.tangential_spring_m = (ft + vt * ct) * (-1.0 / kt);
@@ -103,18 +131,25 @@ inline ContactForces linear_spring_dashpot(const ContactState& c, const PairCoef
     out.tangential_force_N = ft;
 
     // rolling: elastic-plastic spring on the relative rolling rotation
-    if (p.rolling_friction > 0.0) {
-        const Vec3& w = c.relative_angular_velocity_rad_per_s;
+    if (k.rolling_stiffness_N_m_per_rad > 0.0) {
+        const Vec3& w = relative_angular_velocity_rad_per_s;
         const Vec3 w_roll = w - n * dot(w, n);
-        const double kr = rolling_stiffness(kn, p.rolling_friction, c.effective_radius_m);
-        Vec3 mr = rotate_into_tangent_plane(h.rolling_torque_N_m, n) - w_roll * (kr * dt_s);
+        Vec3 mr = rotate_into_tangent_plane(h.rolling_torque_N_m, n) - w_roll * (k.rolling_stiffness_N_m_per_rad * dt_s);
         const double mr2 = norm_squared(mr);
-        const double mr_limit = p.rolling_friction * c.effective_radius_m * out.normal_force_N;
+        const double mr_limit = k.rolling_limit_m * out.normal_force_N;
         if (mr2 > mr_limit * mr_limit) mr = mr2 > 0.0 ? mr * (mr_limit / std::sqrt(mr2)) : Vec3{};
         h.rolling_torque_N_m = mr;
         out.rolling_torque_N_m = mr;
     }
     return out;
+}
+
+/// The same law from a complete ContactState (constants computed on the spot).
+inline ContactForces linear_spring_dashpot(const ContactState& c, const PairCoefficients& p, ContactHistory& h, double dt_s)
+{
+    const ContactConstants k = contact_constants(c.normal_stiffness_N_per_m, c.effective_mass_kg, c.effective_radius_m, p);
+    return linear_spring_dashpot(c.overlap_m, c.normal, c.relative_velocity_m_per_s, c.relative_angular_velocity_rad_per_s,
+                                 k, h, dt_s);
 }
 
 }  // namespace dipper::dem

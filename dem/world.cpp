@@ -32,7 +32,12 @@ World::World(MaterialTable materials, WorldSettings settings) : materials_(std::
     require_in_range(settings_.initial_overlap_tolerance, 0.0, 1.0, "initial_overlap_tolerance", at);
     if (settings_.threads < 0) throw InputError(concat("threads must be >= 0; got ", settings_.threads, " (", at, ")"));
     threads_ = settings_.threads > 0 ? settings_.threads : omp_get_max_threads();
+    for (std::size_t m = 0; m < materials_.size(); ++m)
+        bulk_modulus_Pa_.push_back(materials_.material(static_cast<MaterialIndex>(m)).is_surface
+                                       ? 0.0
+                                       : materials_.material(static_cast<MaterialIndex>(m)).bulk_modulus_Pa());
     thread_wall_contacts_.resize(static_cast<std::size_t>(threads_));
+    thread_wall_hits_.resize(static_cast<std::size_t>(threads_));
 }
 
 std::uint32_t World::add_particle(const ParticleSpawn& spawn, const std::string& where)
@@ -53,8 +58,11 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
     if (material >= materials_.size())
         throw InputError(concat("material index ", material, " does not exist (", at, ")"));
     planes_.push_back({point_m, normalized(normal), material, name});
+    plane_offset_m_.push_back(dot(planes_.back().point_m, planes_.back().normal));
     walls_.push_back({false, static_cast<int>(planes_.size() - 1)});
+    plane_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
     wall_force_N_.resize(walls_.size());
+    rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
 }
@@ -376,6 +384,9 @@ void World::rebuild()
     }
     for (std::size_t k = 0; k < n; ++k) old_to_new[order[k]] = static_cast<std::uint32_t>(k);
     particles_.permute(order);
+    stiffness_radius_N_per_m_.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        stiffness_radius_N_per_m_[i] = bulk_modulus_Pa_[particles_.material[i]] * particles_.radius_m[i];
 
     // carry the history of touching pairs over, renumbered and oriented so that i < j
     struct Carried { std::uint32_t i, j; ContactHistory history; std::uint8_t touching; };
@@ -444,9 +455,6 @@ void World::rebuild()
     const std::size_t pairs = pair_i_.size();
     pair_history_.assign(pairs, ContactHistory{});
     pair_touching_.assign(pairs, 0);
-    pair_force_.assign(pairs, Vec3{});
-    pair_torque_i_.assign(pairs, Vec3{});
-    pair_torque_j_.assign(pairs, Vec3{});
 
     // merge the carried history into the new list (both sorted by (i, j))
     {
@@ -462,21 +470,6 @@ void World::rebuild()
         }
     }
 
-    // CSR of pairs by first particle and, for the gather, by second particle
-    pair_start_.assign(n + 1, 0);
-    reverse_start_.assign(n + 1, 0);
-    for (std::size_t k = 0; k < pairs; ++k) {
-        ++pair_start_[pair_i_[k] + 1];
-        ++reverse_start_[pair_j_[k] + 1];
-    }
-    std::partial_sum(pair_start_.begin(), pair_start_.end(), pair_start_.begin());
-    std::partial_sum(reverse_start_.begin(), reverse_start_.end(), reverse_start_.begin());
-    reverse_pairs_.resize(pairs);
-    {
-        std::vector<std::uint32_t> fill(reverse_start_.begin(), reverse_start_.end() - 1);
-        for (std::size_t k = 0; k < pairs; ++k) reverse_pairs_[fill[pair_j_[k]]++] = static_cast<std::uint32_t>(k);
-    }
-
     // wall contacts keep their history: renumber and re-sort by particle
     for (WallContact& c : wall_contacts_) c.particle = c.particle < n ? old_to_new[c.particle] : std::uint32_t(n);
     wall_contacts_.erase(std::remove_if(wall_contacts_.begin(), wall_contacts_.end(),
@@ -488,20 +481,20 @@ void World::rebuild()
     for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
     std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
 
-    // triangles near each particle
-    build_mesh_candidates(lo, cell, dims, cell_start);
+    // planes and triangles near each particle
+    build_wall_candidates(lo, cell, dims, cell_start);
 
     reference_position_m_ = particles_.position_m;
     reference_mesh_vertices_m_.resize(meshes_.size());
     for (std::size_t m = 0; m < meshes_.size(); ++m) reference_mesh_vertices_m_[m] = meshes_[m].vertices_world_m();
 }
 
-void World::build_mesh_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start)
+void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start)
 {
     const std::size_t n = particles_.size();
     candidate_start_.assign(n + 1, 0);
     candidates_.clear();
-    if (meshes_.empty() || n == 0) return;
+    if (walls_.empty() || n == 0) return;
     double r_max = 0.0;
     for (double r : particles_.radius_m) r_max = std::max(r_max, r);
     const double reach = r_max + skin_m_;
@@ -542,7 +535,7 @@ void World::build_mesh_candidates(const Vec3& lo, double cell, const int dims[3]
         for (const auto& e : entries) bucket[fill[e.first]++] = e.second;
     }
 
-    // each particle keeps the triangles of its own cell that lie within r + skin
+    // each particle keeps the planes, then the triangles of its own cell, that lie within r + skin
     std::vector<std::vector<MeshCandidate>> per_thread(static_cast<std::size_t>(threads_));
     std::vector<std::uint32_t> counts(n, 0);
 #pragma omp parallel num_threads(threads_)
@@ -557,6 +550,11 @@ void World::build_mesh_candidates(const Vec3& lo, double cell, const int dims[3]
             for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - lo[a]) / cell), 0, dims[a] - 1);
             const auto cid = static_cast<std::size_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
             const double range = particles_.radius_m[i] + skin_m_;
+            for (std::size_t q = 0; q < planes_.size(); ++q)
+                if (dot(p, planes_[q].normal) - plane_offset_m_[q] < range) {
+                    out.push_back({static_cast<std::uint32_t>(q), kPlaneCandidate});
+                    ++counts[i];
+                }
             for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1]; ++k) {
                 const MeshCandidate mc = bucket[k];
                 const auto& verts = meshes_[mc.mesh].vertices_world_m();
@@ -578,89 +576,105 @@ void World::build_mesh_candidates(const Vec3& lo, double cell, const int dims[3]
 void World::compute_pair_forces(double dt_s)
 {
     const std::size_t pairs = pair_i_.size();
-    const auto& x = particles_.position_m;
-    const auto& v = particles_.velocity_m_per_s;
-    const auto& w = particles_.angular_velocity_rad_per_s;
-    const auto& r = particles_.radius_m;
-    const auto& m = particles_.mass_kg;
-    const auto& mat = particles_.material;
+    const std::size_t n = particles_.size();
+    // raw pointers: the writes to the force arrays cannot alias the inputs
+    const Vec3* __restrict x = particles_.position_m.data();
+    const Vec3* __restrict v = particles_.velocity_m_per_s.data();
+    const Vec3* __restrict w = particles_.angular_velocity_rad_per_s.data();
+    const double* __restrict r = particles_.radius_m.data();
+    const double* __restrict m = particles_.mass_kg.data();
+    const MaterialIndex* __restrict mat = particles_.material.data();
+    const double* __restrict kr = stiffness_radius_N_per_m_.data();
+    const std::uint32_t* __restrict pi = pair_i_.data();
+    const std::uint32_t* __restrict pj = pair_j_.data();
+    std::uint8_t* __restrict touching = pair_touching_.data();
+    ContactHistory* __restrict history = pair_history_.data();
+    const MaterialTable& table = materials_;
     double max_ratio = 0.0;
+    thread_force_N_.resize(static_cast<std::size_t>(threads_));
+    thread_torque_N_m_.resize(static_cast<std::size_t>(threads_));
 
-#pragma omp parallel for schedule(static) reduction(max : max_ratio) num_threads(threads_)
-    for (std::size_t k = 0; k < pairs; ++k) {
-        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
-        const Vec3 d = x[i] - x[j];
-        const double dist2 = norm_squared(d);
-        const double rsum = r[i] + r[j];
-        if (dist2 >= rsum * rsum) {
-            if (pair_touching_[k]) {  // separated: the history of this contact ends
-                pair_touching_[k] = 0;
-                pair_history_[k] = ContactHistory{};
+    // Each thread takes a fixed block of pairs and adds both particles' shares into its own arrays; the
+    // gather adds the threads' arrays in thread order. Same thread count, same bits.
+#pragma omp parallel num_threads(threads_) reduction(max : max_ratio)
+    {
+        const int t = omp_get_thread_num();
+        thread_force_N_[static_cast<std::size_t>(t)].assign(n, Vec3{});
+        thread_torque_N_m_[static_cast<std::size_t>(t)].assign(n, Vec3{});
+        Vec3* __restrict force = thread_force_N_[static_cast<std::size_t>(t)].data();
+        Vec3* __restrict torque = thread_torque_N_m_[static_cast<std::size_t>(t)].data();
+        std::size_t begin, end;
+        thread_block(pairs, t, threads_, begin, end);
+        double local_max = 0.0;
+        ContactConstants memo;
+        double memo_ri = -1.0, memo_rj = -1.0, memo_mi = -1.0, memo_mj = -1.0;
+        MaterialIndex memo_a = 0, memo_b = 0;
+        for (std::size_t k = begin; k < end; ++k) {
+            const std::uint32_t i = pi[k], j = pj[k];
+            const Vec3 d = x[i] - x[j];
+            const double dist2 = norm_squared(d);
+            const double rsum = r[i] + r[j];
+            if (dist2 >= rsum * rsum) {
+                if (touching[k]) {  // separated: the history of this contact ends
+                    touching[k] = 0;
+                    history[k] = ContactHistory{};
+                }
+                continue;
             }
-            continue;
-        }
-        pair_touching_[k] = 1;
-        const double dist = std::sqrt(dist2);
-        const Vec3 n = dist > 0.0 ? d * (1.0 / dist) : Vec3{0.0, 0.0, 1.0};
-        const double overlap = rsum - dist;
-        max_ratio = std::max(max_ratio, overlap / std::min(r[i], r[j]));
+            touching[k] = 1;
+            const double dist = std::sqrt(dist2);
+            const Vec3 nrm = dist > 0.0 ? d * (1.0 / dist) : Vec3{0.0, 0.0, 1.0};
+            const double overlap = rsum - dist;
+            const double r_min = std::min(r[i], r[j]);
+            if (overlap > local_max * r_min) local_max = overlap / r_min;
 
-        // contact point halfway through the overlap; lever arms from each centre to it
-        const Vec3 arm_i = n * -(r[i] - 0.5 * overlap);
-        const Vec3 arm_j = n * (r[j] - 0.5 * overlap);
-        const MaterialIndex a = mat[i], b = mat[j];
-        const PairCoefficients& p = materials_.pair_unchecked(a, b);
-        ContactState c;
-        c.overlap_m = overlap;
-        c.normal = n;
-        c.relative_velocity_m_per_s = (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j));
-        c.relative_angular_velocity_rad_per_s = w[i] - w[j];
-        c.effective_radius_m = r[i] * r[j] / rsum;
-        c.effective_mass_kg = m[i] * m[j] / (m[i] + m[j]);
-        c.normal_stiffness_N_per_m = pair_normal_stiffness(materials_.material(a).bulk_modulus_Pa(), r[i],
-                                                           materials_.material(b).bulk_modulus_Pa(), r[j],
-                                                           p.normal_stiffness_scale);
-        const ContactForces f = linear_spring_dashpot(c, p, pair_history_[k], dt_s);
-        const Vec3 force = n * f.normal_force_N + f.tangential_force_N;
-        pair_force_[k] = force;
-        pair_torque_i_[k] = cross(arm_i, force) + f.rolling_torque_N_m;
-        pair_torque_j_[k] = cross(arm_j, -force) - f.rolling_torque_N_m;
+            // contact point halfway through the overlap; lever arms from each centre to it
+            const Vec3 arm_i = nrm * -(r[i] - 0.5 * overlap);
+            const Vec3 arm_j = nrm * (r[j] - 0.5 * overlap);
+            // constants of the pair (eq. 4, 6, 8), recomputed only when the pair's kind changes: in a bed of
+            // one size and material they are computed once per thread and step
+            if (r[i] != memo_ri || r[j] != memo_rj || mat[i] != memo_a || mat[j] != memo_b || m[i] != memo_mi || m[j] != memo_mj) {
+                memo_ri = r[i]; memo_rj = r[j]; memo_a = mat[i]; memo_b = mat[j]; memo_mi = m[i]; memo_mj = m[j];
+                const double kr_sum = kr[i] + kr[j], m_sum = m[i] + m[j];
+                const PairCoefficients& p = table.pair_unchecked(mat[i], mat[j]);
+                memo = contact_constants(kr[i] * kr[j] / kr_sum * p.normal_stiffness_scale, m[i] * m[j] / m_sum,
+                                         r[i] * r[j] / rsum, p);
+            }
+            const ContactForces f = linear_spring_dashpot(overlap, nrm, (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j)),
+                                                          w[i] - w[j], memo, history[k], dt_s);
+            const Vec3 fi = nrm * f.normal_force_N + f.tangential_force_N;
+            force[i] += fi;
+            force[j] -= fi;
+            torque[i] += cross(arm_i, fi) + f.rolling_torque_N_m;
+            torque[j] += cross(arm_j, -fi) - f.rolling_torque_N_m;
+        }
+        max_ratio = std::max(max_ratio, local_max);
     }
     max_overlap_ratio_ = max_ratio;
 }
 
-void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallContact>& out) const
+void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const
 {
     const Vec3 x = particles_.position_m[i];
     const double r = particles_.radius_m[i];
+    hits.clear();
+    auto push_hit = [&](const WallHit& h) { hits.push_back(h); };
 
-    struct Hit {
-        std::int32_t wall, triangle;
-        meshes::Feature feature;
-        std::uint32_t feature_id;
-        Vec3 point, normal;
-        double overlap;
-    };
-    Hit hits[32];
-    int hit_count = 0;
-    auto push_hit = [&](const Hit& h) {
-        if (hit_count == 32)
-            throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[i],
-                                         " touches more than 32 wall features at once; the mesh is far finer than the particle"));
-        hits[hit_count++] = h;
-    };
+    const std::uint32_t first = candidate_start_[i], last = candidate_start_[i + 1];
+    if (first == last) return;  // most particles: no wall within reach since the last rebuild
 
-    // analytic planes
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-        if (walls_[w].is_mesh) continue;
-        const PlaneWall& pl = planes_[static_cast<std::size_t>(walls_[w].index)];
-        const double dist = dot(x - pl.point_m, pl.normal);
-        if (dist < r) push_hit({static_cast<std::int32_t>(w), -1, meshes::Feature::Face, 0, x - pl.normal * dist, pl.normal, r - dist});
+    // analytic planes (listed first)
+    std::uint32_t k = first;
+    for (; k < last && candidates_[k].triangle == kPlaneCandidate; ++k) {
+        const std::size_t q = candidates_[k].mesh;
+        const PlaneWall& pl = planes_[q];
+        const double dist = dot(x, pl.normal) - plane_offset_m_[q];
+        if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, x - pl.normal * dist, pl.normal, r - dist, true});
     }
 
     // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
-    const int first_mesh_hit = hit_count;
-    for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1]; ++k) {
+    const int first_mesh_hit = static_cast<int>(hits.size());
+    for (; k < last; ++k) {
         const MeshCandidate mc = candidates_[k];
         const MeshWall& mw = meshes_[mc.mesh];
         const auto& tri = mw.mesh().triangles()[mc.triangle];
@@ -672,7 +686,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallCon
         std::uint32_t feature_id = mc.triangle;
         if (cp.feature == meshes::Feature::Edge) feature_id = mw.mesh().triangle_edges(mc.triangle)[static_cast<std::size_t>(cp.local_index)];
         if (cp.feature == meshes::Feature::Vertex) feature_id = tri[static_cast<std::size_t>(cp.local_index)];
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, cp.point, normal, r - dist});
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, cp.point, normal, r - dist, true});
     }
 
     // One contact per touched feature. A face hit always counts. An edge or vertex hit counts only if no
@@ -680,18 +694,17 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallCon
     // closest point of its neighbourhood: a convex edge or corner), and a feature shared by several
     // triangles counts once. Every triangle closer than a hit is itself a hit (it lies within r), so
     // the check over the hits is exact.
-    bool keep[32];
-    for (int a = 0; a < hit_count; ++a) keep[a] = true;
+    const int hit_count = static_cast<int>(hits.size());
     for (int a = first_mesh_hit; a < hit_count; ++a) {
-        const Hit& h = hits[a];
+        WallHit& h = hits[static_cast<std::size_t>(a)];
         if (h.feature == meshes::Feature::Face) continue;
         const meshes::TriangleMesh& mesh = meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(h.wall)].index)].mesh();
         const double tolerance = 1e-9 * r;
-        for (int b = first_mesh_hit; b < hit_count && keep[a]; ++b) {
-            if (b == a || hits[b].wall != h.wall) continue;
-            const Hit& o = hits[b];
+        for (int b = first_mesh_hit; b < hit_count && h.keep; ++b) {
+            const WallHit& o = hits[static_cast<std::size_t>(b)];
+            if (b == a || o.wall != h.wall) continue;
             if (o.feature == h.feature && o.feature_id == h.feature_id) {
-                if (b < a) keep[a] = false;  // the same feature seen from another triangle: the first one stays
+                if (b < a) h.keep = false;  // the same feature seen from another triangle: the first one stays
                 continue;
             }
             const auto& tri = mesh.triangles()[static_cast<std::size_t>(o.triangle)];
@@ -699,19 +712,18 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallCon
             const bool shares = h.feature == meshes::Feature::Edge
                                     ? (edges[0] == h.feature_id || edges[1] == h.feature_id || edges[2] == h.feature_id)
                                     : (tri[0] == h.feature_id || tri[1] == h.feature_id || tri[2] == h.feature_id);
-            if (shares && o.overlap > h.overlap + tolerance) keep[a] = false;
+            if (shares && o.overlap > h.overlap + tolerance) h.keep = false;
         }
     }
 
     // forces, with history matched to last step's contact of the same wall whose normal is closest
     const std::uint32_t old_begin = i < wall_contact_start_.size() - 1 ? wall_contact_start_[i] : 0;
     const std::uint32_t old_end = i < wall_contact_start_.size() - 1 ? wall_contact_start_[i + 1] : 0;
-    bool used[32] = {};
+    std::uint32_t used = 0;  // bit k: last step's contact k of this particle has been matched
     const Vec3 v = particles_.velocity_m_per_s[i];
     const Vec3 w = particles_.angular_velocity_rad_per_s[i];
-    for (int a = 0; a < hit_count; ++a) {
-        if (!keep[a]) continue;
-        const Hit& h = hits[a];
+    for (const WallHit& h : hits) {
+        if (!h.keep) continue;
         WallContact c;
         c.particle = i;
         c.wall = h.wall;
@@ -721,15 +733,15 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallCon
         c.overlap_m = h.overlap;
         int best = -1;
         double best_dot = 0.9;  // within about 25 degrees: the same contact moving over the surface
-        for (std::uint32_t k = old_begin; k < old_end; ++k) {
-            const WallContact& old = wall_contacts_[k];
-            const int slot = static_cast<int>(k - old_begin);
-            if (old.wall != h.wall || slot >= 32 || used[slot]) continue;
+        for (std::uint32_t o = old_begin; o < old_end; ++o) {
+            const WallContact& old = wall_contacts_[o];
+            const int slot = static_cast<int>(o - old_begin);
+            if (old.wall != h.wall || slot >= 32 || (used >> slot) & 1u) continue;
             const double d = dot(old.normal, h.normal);
             if (d > best_dot) { best_dot = d; best = slot; }
         }
         if (best >= 0) {
-            used[best] = true;
+            used |= 1u << best;
             c.history = wall_contacts_[old_begin + static_cast<std::uint32_t>(best)].history;
         }
 
@@ -747,8 +759,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallCon
         s.relative_angular_velocity_rad_per_s = w - wall_spin;
         s.effective_radius_m = r;
         s.effective_mass_kg = particles_.mass_kg[i];
-        s.normal_stiffness_N_per_m = wall_normal_stiffness(materials_.material(particles_.material[i]).bulk_modulus_Pa(),
-                                                           r, p.normal_stiffness_scale);
+        s.normal_stiffness_N_per_m = wall_normal_stiffness(bulk_modulus_Pa_[particles_.material[i]], r, p.normal_stiffness_scale);
         c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
         c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
         out.push_back(c);
@@ -765,9 +776,10 @@ void World::compute_wall_contacts(double dt_s)
         std::size_t begin, end;
         thread_block(n, t, threads_, begin, end);
         auto& out = thread_wall_contacts_[static_cast<std::size_t>(t)];
+        auto& hits = thread_wall_hits_[static_cast<std::size_t>(t)];
         out.clear();
         if (any_wall)
-            for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, out);
+            for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, hits, out);
     }
     wall_contacts_.clear();
     for (const auto& v : thread_wall_contacts_) wall_contacts_.insert(wall_contacts_.end(), v.begin(), v.end());
@@ -785,17 +797,9 @@ void World::gather_forces()
     for (std::size_t i = 0; i < n; ++i) {
         Vec3 f = g * particles_.mass_kg[i];
         Vec3 torque{};
-        for (std::uint32_t k = pair_start_[i]; k < pair_start_[i + 1]; ++k)
-            if (pair_touching_[k]) {
-                f += pair_force_[k];
-                torque += pair_torque_i_[k];
-            }
-        for (std::uint32_t q = reverse_start_[i]; q < reverse_start_[i + 1]; ++q) {
-            const std::uint32_t k = reverse_pairs_[q];
-            if (pair_touching_[k]) {
-                f -= pair_force_[k];
-                torque += pair_torque_j_[k];
-            }
+        for (std::size_t t = 0; t < thread_force_N_.size(); ++t) {
+            f += thread_force_N_[t][i];
+            torque += thread_torque_N_m_[t][i];
         }
         for (std::uint32_t k = wall_contact_start_[i]; k < wall_contact_start_[i + 1]; ++k) {
             const WallContact& c = wall_contacts_[k];

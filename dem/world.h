@@ -116,7 +116,18 @@ private:
         ContactHistory history;
         ContactForces forces;
     };
+    /// A wall within reach of a particle: triangle of a mesh, or plane `mesh` when triangle == kPlaneCandidate.
     struct MeshCandidate { std::uint32_t mesh, triangle; };
+    static constexpr std::uint32_t kPlaneCandidate = 0xffffffffu;
+    /// A touched wall feature before the one-contact-per-feature filter.
+    struct WallHit {
+        std::int32_t wall, triangle;
+        meshes::Feature feature;
+        std::uint32_t feature_id;
+        Vec3 point, normal;
+        double overlap;
+        bool keep;
+    };
 
     void prepare();
     void validate_step();
@@ -124,17 +135,18 @@ private:
     void move_prescribed_meshes(double t_end_s, double dt_s);
     bool needs_rebuild() const;
     void rebuild();
-    void build_mesh_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
+    void build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
     void evaluate_forces(double dt_s);
     void compute_pair_forces(double dt_s);
     void compute_wall_contacts(double dt_s);
-    void find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallContact>& out) const;
+    void find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const;
     void gather_forces();
     void finish_step(double dt_s);
     [[noreturn]] void fail_overlap() const;
     std::string where_in_time() const;
 
     MaterialTable materials_;
+    std::vector<double> bulk_modulus_Pa_;  ///< per material, cached (eq. 5)
     WorldSettings settings_;
     int threads_ = 1;
     ParticleStore particles_;
@@ -142,18 +154,22 @@ private:
     std::vector<MeshWall> meshes_;
     std::vector<WallRef> walls_;
     std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
+    std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
+    std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
 
     double time_s_ = 0.0, step_s_ = 0.0;
     std::uint64_t step_count_ = 0, rebuild_count_ = 0;
     bool prepared_ = false, rebuild_needed_ = true, step_checked_ = false;
 
-    // neighbour list: pairs (i < j) sorted by i then j; per-pair history and force slots
-    std::vector<std::uint32_t> pair_i_, pair_j_, pair_start_, reverse_start_, reverse_pairs_;
+    // neighbour list: pairs (i < j) sorted by i then j, with their contact history
+    std::vector<std::uint32_t> pair_i_, pair_j_;
     std::vector<ContactHistory> pair_history_;
     std::vector<std::uint8_t> pair_touching_;
-    std::vector<Vec3> pair_force_, pair_torque_i_, pair_torque_j_;
+    // pair forces and torques accumulated by each thread, added up per particle in thread order
+    std::vector<std::vector<Vec3>> thread_force_N_, thread_torque_N_m_;
     std::vector<Vec3> reference_position_m_;
+    std::vector<double> stiffness_radius_N_per_m_;  ///< k r per particle (eq. 4), refreshed at each rebuild
     std::vector<std::vector<Vec3>> reference_mesh_vertices_m_;
     double skin_m_ = 0.0;
 
@@ -163,6 +179,7 @@ private:
     std::vector<std::uint32_t> candidate_start_;
     std::vector<MeshCandidate> candidates_;
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
+    std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_;
     std::vector<ContactRecord> records_;
     double max_overlap_ratio_ = 0.0;

@@ -48,19 +48,21 @@ TEST_CASE("settled bed: floor force equals total weight and motion dies out", "[
     CHECK(translational_J < 1e-6 * released_J);
 }
 
-TEST_CASE("results are bitwise repeatable for a thread count, and equal across thread counts", "[dem][unit]")
+TEST_CASE("results are bitwise repeatable for a given thread count", "[dem][unit]")
 {
-    // The pair forces are gathered per particle in a fixed order, so even the thread count does not change
-    // a single bit.
-    World a = make_box_bed(2), b = make_box_bed(2), c = make_box_bed(1);
-    for (int k = 0; k < 3000; ++k) {
-        a.step();
-        b.step();
-        c.step();
+    // Each thread owns a fixed block of pairs and its own force arrays, added in thread order: for one
+    // thread count the sums are always formed in the same order. Across thread counts they differ by
+    // round-off only.
+    for (int threads : {1, 2}) {
+        World a = make_box_bed(threads), b = make_box_bed(threads);
+        for (int k = 0; k < 3000; ++k) {
+            a.step();
+            b.step();
+        }
+        CAPTURE(threads);
+        CHECK(a.rebuild_count() > 2);
+        CHECK(test::state_hash(a) == test::state_hash(b));
     }
-    CHECK(a.rebuild_count() > 2);
-    CHECK(test::state_hash(a) == test::state_hash(b));
-    CHECK(test::state_hash(a) == test::state_hash(c));
 }
 
 TEST_CASE("contact history survives neighbour-list rebuilds", "[dem][unit]")
