@@ -124,8 +124,10 @@ TEST_CASE("oblique impacts of Chung & Ooi (2011) test 4 in the gross-sliding ran
     // alumina sphere R 2.5 mm, 4000 kg/m3, E 380 GPa, nu 0.23, 3.9 m/s, mu 0.092 against a rigid plane.
     // While the contact slides throughout, the impulse ratio is mu: v_t'/v_t = 1 - mu (1 + e) / tan(theta)
     // and omega' = 2.5 mu (1 + e) v cos(theta) / R (theta from the normal, e the normal restitution).
-    // The closed forms are exact for the law when sliding lasts the whole contact; the 2 % tolerance of
-    // the issue covers the first steps in which the tangential spring builds up.
+    // While sliding, every step's tangential impulse is exactly mu times the normal one, so the tangential
+    // restitution matches to round-off (1e-9). The spin differs by the lever arm: the force acts on the
+    // wall surface at r - delta, and delta / r <= 1.1e-3 at 3.9 m/s; 2e-3 covers it. (The issue asks for
+    // 2 % on both.)
     const double r = 2.5e-3, v = 3.9, mu = 0.092;
     MaterialTable t;
     t.add({"alumina", 4000.0, 380e9, 0.23, false});
@@ -158,9 +160,9 @@ TEST_CASE("oblique impacts of Chung & Ooi (2011) test 4 in the gross-sliding ran
         CHECK(w.kinetic_energy_J() <= energy_before * (1.0 + 1e-12));
         if (angle_deg >= 35) {
             const double tangential_restitution = vout.x / (v * std::sin(theta));
-            CHECK(tangential_restitution == Approx(1.0 - mu * (1.0 + e) / std::tan(theta)).epsilon(0.02));
+            CHECK(tangential_restitution == Approx(1.0 - mu * (1.0 + e) / std::tan(theta)).epsilon(1e-9));
             // positive spin about +y is forward rolling for motion along +x on a floor below
-            CHECK(spin.y == Approx(2.5 * mu * (1.0 + e) * v * std::cos(theta) / r).epsilon(0.02));
+            CHECK(spin.y == Approx(2.5 * mu * (1.0 + e) * v * std::cos(theta) / r).epsilon(2e-3));
         }
     }
 }
