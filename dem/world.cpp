@@ -607,6 +607,7 @@ void World::compute_pair_forces(double dt_s)
         thread_block(pairs, t, threads_, begin, end);
         double local_max = 0.0;
         ContactConstants memo;
+        double memo_share_i = 0.5;
         double memo_ri = -1.0, memo_rj = -1.0, memo_mi = -1.0, memo_mj = -1.0;
         MaterialIndex memo_a = 0, memo_b = 0;
         for (std::size_t k = begin; k < end; ++k) {
@@ -628,9 +629,6 @@ void World::compute_pair_forces(double dt_s)
             const double r_min = std::min(r[i], r[j]);
             if (overlap > local_max * r_min) local_max = overlap / r_min;
 
-            // contact point halfway through the overlap; lever arms from each centre to it
-            const Vec3 arm_i = nrm * -(r[i] - 0.5 * overlap);
-            const Vec3 arm_j = nrm * (r[j] - 0.5 * overlap);
             // constants of the pair (eq. 4, 6, 8), recomputed only when the pair's kind changes: in a bed of
             // one size and material they are computed once per thread and step
             if (r[i] != memo_ri || r[j] != memo_rj || mat[i] != memo_a || mat[j] != memo_b || m[i] != memo_mi || m[j] != memo_mj) {
@@ -639,7 +637,14 @@ void World::compute_pair_forces(double dt_s)
                 const PairCoefficients& p = table.pair_unchecked(mat[i], mat[j]);
                 memo = contact_constants(kr[i] * kr[j] / kr_sum * p.normal_stiffness_scale, m[i] * m[j] / m_sum,
                                          r[i] * r[j] / rsum, p);
+                memo_share_i = kr[j] / kr_sum;
             }
+            // The two springs k1 r1 and k2 r2 in series share the overlap in proportion to their compliances:
+            // the contact point lies half-way for equal spheres and on the surface of a much stiffer body (the
+            // wall limit). Lever arms from each centre to that point:
+            const double deflection_i = memo_share_i * overlap;
+            const Vec3 arm_i = nrm * -(r[i] - deflection_i);
+            const Vec3 arm_j = nrm * (r[j] - (overlap - deflection_i));
             const ContactForces f = linear_spring_dashpot(overlap, nrm, (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j)),
                                                           w[i] - w[j], memo, history[k], dt_s);
             const Vec3 fi = nrm * f.normal_force_N + f.tangential_force_N;

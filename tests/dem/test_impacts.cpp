@@ -196,3 +196,33 @@ TEST_CASE("equal and opposite spins meeting head on: no tangential force, spins 
     }
     CHECK(pp.velocity_m_per_s[test::index_of_id(w, 0)].x < 0.0);  // they did bounce
 }
+
+TEST_CASE("a sphere against a huge, heavy sphere behaves as against a wall", "[dem][analytic]")
+{
+    // One law serves both: with r2 = 1e4 m and m2 -> 1e15 kg, Kn, m* and R* differ from the wall values
+    // by r1 / r2 = 1e-5 at most, so an oblique, spinning impact must end the same within 1e-4.
+    const double r = 0.05, big = 1e4;
+    const PairCoefficients p = test::coefficients(0.4, 0.1, 0.5, 0.5);
+    MaterialTable table = test::two_material_table(p, 2500.0, 1e9, 0.25);
+    table.add({"anvil", 2500.0, 1e9, 0.25, false});
+    table.set_pair("p", "anvil", p);
+    table.set_pair("anvil", "anvil", p);
+    WorldSettings s;
+    s.gravity_m_per_s2 = {};
+    World on_wall(table, s), on_sphere(table, s);
+    const ParticleSpawn ball{{0.0, 0.0, r + 1e-4}, {0.7, 0.2, -1.0}, {3.0, -2.0, 1.0}, r, 0};
+    on_wall.add_plane({0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, 1, "wall");
+    on_wall.add_particle(ball);
+    on_sphere.add_particle(ball);
+    on_sphere.add_particle({{0.0, 0.0, -big}, {}, {}, big, 2});
+    for (int k = 0; k < 4000; ++k) {
+        on_wall.step();
+        on_sphere.step();
+    }
+    const std::size_t a = test::index_of_id(on_wall, 0), b = test::index_of_id(on_sphere, 0);
+    const Vec3 va = on_wall.particles().velocity_m_per_s[a], vb = on_sphere.particles().velocity_m_per_s[b];
+    const Vec3 wa = on_wall.particles().angular_velocity_rad_per_s[a], wb = on_sphere.particles().angular_velocity_rad_per_s[b];
+    REQUIRE(va.z > 0.1);  // it bounced
+    CHECK(norm(va - vb) < 1e-4 * norm(va));
+    CHECK(norm(wa - wb) < 1e-4 * norm(wa));
+}
