@@ -110,3 +110,19 @@ TEST_CASE("law properties: zero force without overlap motion, symmetry of a swap
         CHECK(fa.rolling_torque_N_m == -fb.rolling_torque_N_m);
     }
 }
+
+TEST_CASE("history springs are carried into the new tangent plane with their length", "[dem][unit]")
+{
+    // small turns use a series for the length correction, large ones the closed form: both must give a
+    // vector in the plane with the old length (1e-14 relative), for turns from 1e-6 rad to 80 degrees
+    const Vec3 spring{3e-4, -1e-4, 0.0};
+    for (double angle : {1e-6, 1e-4, 1e-3, 1e-2, 0.1, 0.5, 1.4}) {
+        const Vec3 n = normalized(Vec3{std::sin(angle), 0.3 * std::sin(angle), std::cos(angle)});
+        const Vec3 turned = rotate_into_tangent_plane(spring, n);
+        CAPTURE(angle);
+        CHECK(std::abs(dot(turned, n)) < 1e-14 * norm(spring));
+        CHECK(norm(turned) == Approx(norm(spring)).epsilon(1e-14));
+    }
+    CHECK(norm(rotate_into_tangent_plane(Vec3{0, 0, 1e-4}, Vec3{0, 0, 1})) == 0.0);  // along the normal: nothing left
+    CHECK(norm(rotate_into_tangent_plane(Vec3{}, Vec3{0, 0, 1})) == 0.0);
+}
