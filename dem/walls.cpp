@@ -43,6 +43,7 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
 void MeshWall::set_pose(const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_world_m,
                         const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s)
 {
+    ++pose_version_;
     rotation_ = rotation;
     translation_ = translation_m;
     reference_point_ = reference_point_world_m;

@@ -5,6 +5,7 @@
 #include "dem/material.h"
 #include "meshes/triangle_mesh.h"
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -61,6 +62,8 @@ public:
     const std::string& name() const { return name_; }
     const Mat3& rotation() const { return rotation_; }
     const Vec3& translation_m() const { return translation_; }
+    /// Counts pose changes, so that neighbour lists notice a wall moved from outside.
+    std::uint64_t pose_version() const { return pose_version_; }
 
 private:
     meshes::TriangleMesh mesh_;
@@ -72,6 +75,7 @@ private:
     Vec3 reference_point_, reference_velocity_, angular_velocity_;
     std::vector<Vec3> vertices_world_;
     std::vector<Vec3> normals_world_;
+    std::uint64_t pose_version_ = 0;
 };
 
 }  // namespace dipper::dem

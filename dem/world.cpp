@@ -276,7 +276,7 @@ bool World::needs_rebuild() const
 
     double mesh_move2 = 0.0;
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
-        if (!meshes_[m].motion()) continue;
+        if (meshes_[m].pose_version() == reference_mesh_version_[m]) continue;  // not moved since the rebuild
         const auto& now = meshes_[m].vertices_world_m();
         const auto& then = reference_mesh_vertices_m_[m];
         for (std::size_t k = 0; k < now.size(); ++k) mesh_move2 = std::max(mesh_move2, norm_squared(now[k] - then[k]));
@@ -486,7 +486,11 @@ void World::rebuild()
 
     reference_position_m_ = particles_.position_m;
     reference_mesh_vertices_m_.resize(meshes_.size());
-    for (std::size_t m = 0; m < meshes_.size(); ++m) reference_mesh_vertices_m_[m] = meshes_[m].vertices_world_m();
+    reference_mesh_version_.resize(meshes_.size());
+    for (std::size_t m = 0; m < meshes_.size(); ++m) {
+        reference_mesh_vertices_m_[m] = meshes_[m].vertices_world_m();
+        reference_mesh_version_[m] = meshes_[m].pose_version();
+    }
 }
 
 void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start)

@@ -171,6 +171,7 @@ private:
     std::vector<Vec3> reference_position_m_;
     std::vector<double> stiffness_radius_N_per_m_;  ///< k r per particle (eq. 4), refreshed at each rebuild
     std::vector<std::vector<Vec3>> reference_mesh_vertices_m_;
+    std::vector<std::uint64_t> reference_mesh_version_;
     double skin_m_ = 0.0;
 
     // sphere-wall contacts of the last step, sorted by particle, and mesh triangle candidates

@@ -160,3 +160,27 @@ TEST_CASE("contact records carry force, point and relative displacement of a sli
     CHECK(c.relative_displacement_m.x == Approx(3.0 * w.step_s()).epsilon(0.01));
     CHECK(c.point_world.z == Approx(0.0).margin(1e-12));
 }
+
+TEST_CASE("a mesh moved from outside is seen by the neighbour lists", "[dem][walls][unit]")
+{
+    // A plate 1 m away approaches a free sphere at 1 m/s, moved only through set_mesh_pose (as the coupling
+    // moves machine parts). The lists were built when the plate was far beyond the skin: it must still hit
+    // the sphere and push it along -x (an elastic push from a massive wall: about twice the plate speed).
+    WorldSettings s;
+    s.gravity_m_per_s2 = {};
+    s.step_s = 5e-6;  // 1/60 of the contact time: the discrete wall motion's error is O((omega dt)^2)
+    World w(test::two_material_table(test::coefficients(0.0, 0.0, 0.0, 0.0, 0.05, 0.27), 3700.0, 45e9, 0.3), s);
+    meshes::TriangleMesh plate = meshes::make_plate_mesh(1.0, 1.0, 2, 2);
+    std::vector<Vec3> v = plate.vertices_m();
+    for (Vec3& p : v) p = {0.0, p.x - 0.5, p.y - 0.5};  // the plane x = 0 with normal +x
+    const int id = w.add_mesh(meshes::TriangleMesh(v, plate.triangles(), "plate"), 1, "plate");
+    w.add_particle({{0.0, 0.0, 0.0}, {}, {}, 0.1, 0});
+    const Mat3 face_minus_x = rotation_about_axis({0.0, 0.0, 1.0}, M_PI);  // normal +x turned to -x
+    while (w.time_s() < 1.2) {
+        const double t = w.time_s() + w.step_s();
+        const Vec3 position{1.0 - t, 0.0, 0.0};
+        w.set_mesh_pose(id, face_minus_x, position, position, {-1.0, 0.0, 0.0}, {});
+        w.step();
+    }
+    CHECK(w.particles().velocity_m_per_s[0].x == Approx(-2.0).epsilon(1e-3));
+}
