@@ -5,7 +5,7 @@
 // N = 20,000), settled under gravity, then timed over --steps steps at dt = 5e-5 s. The last line is
 // `particle-steps/s: <number>`.
 //
-// usage: dipper_bench_bed [--particles N] [--threads T] [--steps S] [--settle-s SECONDS] [--cache FILE]
+// usage: dipper_bench_bed [--particles N] [--threads T] [--steps S] [--settle-s SECONDS] [--cache FILE] [--skin F]
 // --cache keeps the settled bed (positions and velocities) in FILE: a later run with the same N loads it
 // and settles for 0.05 s more, so that contact springs are rebuilt before the timed steps.
 #include "dem/insertion.h"
@@ -35,7 +35,7 @@ long peak_resident_kib()
 
 [[noreturn]] void usage(const char* message)
 {
-    std::fprintf(stderr, "dipper_bench_bed: %s\nusage: dipper_bench_bed [--particles N] [--threads T] [--steps S] [--settle-s SECONDS] [--cache FILE]\n", message);
+    std::fprintf(stderr, "dipper_bench_bed: %s\nusage: dipper_bench_bed [--particles N] [--threads T] [--steps S] [--settle-s SECONDS] [--cache FILE] [--skin FRACTION_OF_RADIUS]\n", message);
     std::exit(2);
 }
 
@@ -46,6 +46,7 @@ int main(int argc, char** argv)
     long particles = 20000, threads = 1, steps = 2000;
     double settle_s = 1.2;
     std::string cache;
+    double skin = WorldSettings{}.skin_fraction_of_radius;
     for (int a = 1; a < argc; ++a) {
         auto value = [&](const char* name) {
             if (a + 1 >= argc) usage((std::string(name) + " needs a value").c_str());
@@ -56,15 +57,17 @@ int main(int argc, char** argv)
         else if (!std::strcmp(argv[a], "--steps")) steps = std::atol(value("--steps"));
         else if (!std::strcmp(argv[a], "--settle-s")) settle_s = std::atof(value("--settle-s"));
         else if (!std::strcmp(argv[a], "--cache")) cache = value("--cache");
+        else if (!std::strcmp(argv[a], "--skin")) skin = std::atof(value("--skin"));
         else usage((std::string("unknown option ") + argv[a]).c_str());
     }
-    if (particles < 1 || threads < 1 || steps < 1 || !(settle_s >= 0.0)) usage("values must be positive");
+    if (particles < 1 || threads < 1 || steps < 1 || !(settle_s >= 0.0) || !(skin > 0.0)) usage("values must be positive");
 
     const double r = 0.1;
     const double length = particles >= 100000 ? 20.0 : 10.0, width = particles >= 100000 ? 12.5 : 5.0;
     WorldSettings settings;
     settings.step_s = 5e-5;
     settings.threads = static_cast<int>(threads);
+    settings.skin_fraction_of_radius = skin;
     World world(MaterialTable::aitik_copper_ore(), settings);
     const auto& m = world.materials();
     world.add_plane({0, 0, 0}, {0, 0, 1}, m.index_of("ground"), "floor");
