@@ -3,6 +3,7 @@
 #include "core/errors.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -50,8 +51,21 @@ std::uint32_t World::add_particle(const ParticleSpawn& spawn, const std::string&
     return id;
 }
 
+void World::check_wall_name(const std::string& name) const
+{
+    // names become column headers and file names: letters, digits, '_', '-', '.'
+    const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+    });
+    if (!plain)
+        throw InputError(concat("wall name '", name, "' must be non-empty and use only letters, digits, '_', '-' and '.'"));
+    for (std::size_t w = 0; w < walls_.size(); ++w)
+        if (wall_name(static_cast<int>(w)) == name) throw InputError(concat("wall name '", name, "' is used twice"));
+}
+
 int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex material, const std::string& name)
 {
+    check_wall_name(name);
     const std::string at = "plane '" + name + "'";
     if (!is_finite(point_m) || !is_finite(normal) || norm(normal) < 1e-12)
         throw InputError(concat("plane point and normal must be finite and the normal non-zero (", at, ")"));
@@ -70,6 +84,7 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
 int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std::string& name,
                     std::optional<PrescribedMotion> motion)
 {
+    check_wall_name(name);
     if (material >= materials_.size())
         throw InputError(concat("material index ", material, " does not exist (mesh '", name, "')"));
     if (motion && !(is_finite(motion->velocity_m_per_s) && is_finite(motion->angular_velocity_rad_per_s) &&

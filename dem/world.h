@@ -130,6 +130,7 @@ private:
     };
 
     void prepare();
+    void check_wall_name(const std::string& name) const;
     void validate_step();
     void check_initial_overlaps() const;
     void move_prescribed_meshes(double t_end_s, double dt_s);

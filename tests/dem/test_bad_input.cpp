@@ -3,6 +3,7 @@
 #include "dem/world.h"
 #include "helpers.h"
 #include "meshes/mesh_io.h"
+#include "meshes/triangle_mesh.h"
 
 #include <catch2/catch.hpp>
 
@@ -101,4 +102,17 @@ TEST_CASE("missing, corrupt and degenerate mesh files are refused by name", "[me
         f << "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\nf 1 2 3\n";  // the second triangle is a line
     }
     REQUIRE_THROWS_WITH(meshes::load_triangle_mesh(degenerate), Contains(degenerate) && Contains("triangle 1") && Contains("degenerate"));
+}
+
+TEST_CASE("walls need plain, unique names and a valid material", "[dem][input][unit]")
+{
+    World w(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    w.add_plane({}, {0, 0, 1}, 2, "floor");
+    REQUIRE_THROWS_WITH(w.add_plane({}, {0, 0, 1}, 2, "floor"), Contains("'floor' is used twice"));
+    REQUIRE_THROWS_WITH(w.add_plane({}, {0, 0, 1}, 2, "back wall"), Contains("'back wall'") && Contains("letters, digits"));
+    REQUIRE_THROWS_WITH(w.add_plane({}, {0, 0, 0}, 2, "zero"), Contains("normal non-zero"));
+    REQUIRE_THROWS_WITH(w.add_plane({}, {0, 0, 1}, 77, "bad_material"), Contains("material index 77"));
+    PrescribedMotion runaway;
+    runaway.velocity_m_per_s = {std::nan(""), 0, 0};
+    REQUIRE_THROWS_WITH(w.add_mesh(meshes::make_plate_mesh(1, 1, 1, 1), 2, "plate", runaway), Contains("'plate'") && Contains("finite"));
 }
