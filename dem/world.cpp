@@ -253,7 +253,7 @@ void World::step()
     // neighbour lists, rebuilt when a particle or a wall has used up the skin
     if (rebuild_needed_ || needs_rebuild()) rebuild();
 
-    // forces: sphere pairs into per-pair slots, wall contacts per particle, then a gather per particle
+    // forces: sphere pairs into per-thread arrays, wall contacts per particle, then a gather per particle
     evaluate_forces(dt);
 
     // second half kick with the new forces
