@@ -371,14 +371,13 @@ void World::rebuild()
     int dims[3];
     const std::size_t max_cells = std::max<std::size_t>(64, 4 * n);
     for (;;) {
-        std::size_t total = 1;
-        for (int a = 0; a < 3; ++a) {
-            dims[a] = static_cast<int>((hi[a] - lo[a]) / cell) + 1;
-            total *= static_cast<std::size_t>(dims[a]);
-        }
-        if (total <= max_cells) break;
-        cell *= 1.25;  // sparse, spread-out particles: coarser cells keep the grid small
+        // counted in doubles: a particle thrown far away must not overflow the cell count
+        double total = 1.0;
+        for (int a = 0; a < 3; ++a) total *= std::floor((hi[a] - lo[a]) / cell) + 1.0;
+        if (total <= static_cast<double>(max_cells)) break;
+        cell *= std::max(1.25, std::cbrt(total / static_cast<double>(max_cells)));  // sparse: coarser cells
     }
+    for (int a = 0; a < 3; ++a) dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
     const std::size_t cell_count = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
     auto cell_of = [&](const Vec3& p) {
         int c[3];

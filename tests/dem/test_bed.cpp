@@ -100,3 +100,17 @@ TEST_CASE("contact history survives neighbour-list rebuilds", "[dem][unit]")
     CHECK(spring_size > 1e-8);
     CHECK(spring_difference < 1e-6 * spring_size);
 }
+
+TEST_CASE("a particle thrown far away does not break the neighbour grid", "[dem][unit]")
+{
+    // one sphere 1e9 m from the others: the grid coarsens instead of allocating (or overflowing) cells
+    WorldSettings s;
+    s.gravity_m_per_s2 = {};
+    World w(MaterialTable::aitik_copper_ore(), s);
+    w.add_particle({{0, 0, 0}, {}, {}, 0.1, 0});
+    w.add_particle({{0.25, 0, 0}, {-1, 0, 0}, {}, 0.1, 0});
+    w.add_particle({{1e9, 1e9, 1e9}, {}, {}, 0.1, 0});
+    w.run_steps(2000);
+    CHECK(w.rebuild_count() >= 1);
+    CHECK(w.particles().velocity_m_per_s[test::index_of_id(w, 0)].x < -0.1);  // the pair still collided
+}
