@@ -38,10 +38,12 @@ const PairCoefficients kOre{0.05, 0.27, 0.9, 0.05, 0.9, 0.75};
 const double kKn = pair_normal_stiffness(37.5e9, 0.1, 37.5e9, 0.1, 0.05);
 const double kMass = 0.5 * 4.0 / 3.0 * M_PI * 1e-3 * 3700.0;
 
-void run(benchmark::State& state, bool slide)
+void run(benchmark::State& state, bool slide, bool rolling = true)
 {
     Batch b = make_batch(slide);
-    const ContactConstants k = contact_constants(kKn, kMass, 0.05, kOre);
+    PairCoefficients pair = kOre;
+    if (!rolling) pair.rolling_friction = 0.0;
+    const ContactConstants k = contact_constants(kKn, kMass, 0.05, pair);
     for (auto _ : state) {
         for (std::size_t c = 0; c < kContacts; ++c) {
             const ContactForces f = linear_spring_dashpot(b.overlap[c], b.normal[c], b.velocity[c], b.spin[c], k, b.history[c], 5e-5);
@@ -53,6 +55,7 @@ void run(benchmark::State& state, bool slide)
 
 void BM_RestingContact(benchmark::State& state) { run(state, false); }
 void BM_SlidingContact(benchmark::State& state) { run(state, true); }
+void BM_RestingContactNoRolling(benchmark::State& state) { run(state, false, false); }
 
 void BM_RestingContactWithConstants(benchmark::State& state)
 {
@@ -78,5 +81,6 @@ void BM_RestingContactWithConstants(benchmark::State& state)
 
 BENCHMARK(BM_RestingContact);
 BENCHMARK(BM_SlidingContact);
+BENCHMARK(BM_RestingContactNoRolling);
 BENCHMARK(BM_RestingContactWithConstants);
 BENCHMARK_MAIN();
