@@ -212,16 +212,16 @@ void World::prepare()
         check_initial_overlaps();
         // velocity Verlet starts from the forces of the initial state; a zero-length step leaves the
         // contact springs where they are
-        evaluate_forces(0.0);
+        evaluate_forces(0.0, 0.0);
         prepared_ = true;
     }
 }
 
-void World::evaluate_forces(double dt_s)
+void World::evaluate_forces(double dt_s, double half_kick_s)
 {
     compute_pair_forces(dt_s);
     compute_wall_contacts(dt_s);
-    gather_forces();
+    gather_forces_and_kick(half_kick_s);
 }
 
 void World::run_steps(std::uint64_t n)
@@ -239,29 +239,28 @@ void World::step()
     auto& v = particles_.velocity_m_per_s;
     auto& w = particles_.angular_velocity_rad_per_s;
 
-    // first half kick with last step's forces, then drift (velocity Verlet)
-#pragma omp parallel for schedule(static) num_threads(threads_)
+    // first half kick with last step's forces, then drift (velocity Verlet); the largest move since the
+    // last neighbour-list rebuild comes along
+    const bool tracked = reference_position_m_.size() == n;
+    const Vec3* reference = reference_position_m_.data();
+    double max_move2 = 0.0;
+#pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : max_move2)
     for (std::size_t i = 0; i < n; ++i) {
         v[i] += particles_.force_N[i] * (0.5 * dt * particles_.inverse_mass_per_kg[i]);
         w[i] += particles_.torque_N_m[i] * (0.5 * dt * particles_.inverse_inertia_per_kg_m2[i]);
         x[i] += v[i] * dt;
+        if (tracked) max_move2 = std::max(max_move2, norm_squared(x[i] - reference[i]));
     }
 
     // moving walls to the end of the step, their velocities at mid-step
     move_prescribed_meshes(time_s_ + dt, dt);
 
     // neighbour lists, rebuilt when a particle or a wall has used up the skin
-    if (rebuild_needed_ || needs_rebuild()) rebuild();
+    if (rebuild_needed_ || !tracked || needs_rebuild(std::sqrt(max_move2))) rebuild();
 
-    // forces: sphere pairs into per-thread arrays, wall contacts per particle, then a gather per particle
-    evaluate_forces(dt);
-
-    // second half kick with the new forces
-#pragma omp parallel for schedule(static) num_threads(threads_)
-    for (std::size_t i = 0; i < n; ++i) {
-        v[i] += particles_.force_N[i] * (0.5 * dt * particles_.inverse_mass_per_kg[i]);
-        w[i] += particles_.torque_N_m[i] * (0.5 * dt * particles_.inverse_inertia_per_kg_m2[i]);
-    }
+    // forces: sphere pairs into per-thread arrays, wall contacts per particle, then per particle the sum
+    // and the second half kick
+    evaluate_forces(dt, 0.5 * dt);
     finish_step(dt);
 }
 
@@ -279,15 +278,9 @@ void World::move_prescribed_meshes(double t_end_s, double dt_s)
     }
 }
 
-bool World::needs_rebuild() const
+bool World::needs_rebuild(double particle_move_m) const
 {
-    const std::size_t n = particles_.size();
-    double max_d2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : max_d2) num_threads(threads_)
-    for (std::size_t i = 0; i < n; ++i)
-        max_d2 = std::max(max_d2, norm_squared(particles_.position_m[i] - reference_position_m_[i]));
-    const double particle_move = std::sqrt(max_d2);
-    if (2.0 * particle_move > skin_m_) return true;
+    if (2.0 * particle_move_m > skin_m_) return true;
 
     double mesh_move2 = 0.0;
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
@@ -296,7 +289,7 @@ bool World::needs_rebuild() const
         const auto& then = reference_mesh_vertices_m_[m];
         for (std::size_t k = 0; k < now.size(); ++k) mesh_move2 = std::max(mesh_move2, norm_squared(now[k] - then[k]));
     }
-    return particle_move + std::sqrt(mesh_move2) > skin_m_;
+    return particle_move_m + std::sqrt(mesh_move2) > skin_m_;
 }
 
 void World::finish_step(double dt_s)
@@ -811,7 +804,7 @@ void World::compute_wall_contacts(double dt_s)
     std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
 }
 
-void World::gather_forces()
+void World::gather_forces_and_kick(double half_kick_s)
 {
     const std::size_t n = particles_.size();
     const Vec3 g = settings_.gravity_m_per_s2;
@@ -832,6 +825,8 @@ void World::gather_forces()
         }
         particles_.force_N[i] = f;
         particles_.torque_N_m[i] = torque;
+        particles_.velocity_m_per_s[i] += f * (half_kick_s * particles_.inverse_mass_per_kg[i]);
+        particles_.angular_velocity_rad_per_s[i] += torque * (half_kick_s * particles_.inverse_inertia_per_kg_m2[i]);
         if (!is_finite(f) || !is_finite(torque) || !is_finite(particles_.position_m[i])) bad = std::max(bad, static_cast<int>(i));
     }
     if (bad >= 0) {

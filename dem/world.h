@@ -134,14 +134,14 @@ private:
     void validate_step();
     void check_initial_overlaps() const;
     void move_prescribed_meshes(double t_end_s, double dt_s);
-    bool needs_rebuild() const;
+    bool needs_rebuild(double particle_move_m) const;
     void rebuild();
     void build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
-    void evaluate_forces(double dt_s);
+    void evaluate_forces(double dt_s, double half_kick_s);
     void compute_pair_forces(double dt_s);
     void compute_wall_contacts(double dt_s);
     void find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const;
-    void gather_forces();
+    void gather_forces_and_kick(double half_kick_s);
     void finish_step(double dt_s);
     [[noreturn]] void fail_overlap() const;
     std::string where_in_time() const;
