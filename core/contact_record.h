@@ -23,6 +23,7 @@ struct ContactRecord {
     std::int32_t triangle_id = -1;       ///< triangle of that mesh; -1 for analytic planes
     std::int32_t particle_index = -1;    ///< dense index of the particle in its store during this step
     double particle_mass_kg = 0.0;       ///< mass of the particle (impact-energy wear laws use it)
+    bool first_step = false;             ///< true on the first step of this contact: an impact
 };
 
 /// Receives the surface contacts of one step, in a deterministic order (by particle, then surface).

@@ -1,6 +1,8 @@
 #include "dem/output.h"
 
 #include "core/errors.h"
+#include "core/files.h"
+#include "meshes/vtk_surface.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -9,14 +11,6 @@
 namespace dipper::dem {
 
 namespace {
-
-std::ofstream open_for_writing(const std::string& path)
-{
-    std::ofstream out(path);
-    if (!out) throw InputError(concat("cannot open '", path, "' for writing"));
-    out << std::setprecision(10);
-    return out;
-}
 
 void write_vec3_array(std::ostream& out, const char* name, const std::vector<Vec3>& values)
 {
@@ -31,12 +25,6 @@ void write_scalar_array(std::ostream& out, const char* type, const char* name, c
     out << "<DataArray type=\"" << type << "\" Name=\"" << name << "\" format=\"ascii\">\n";
     for (const T& v : values) out << +v << '\n';
     out << "</DataArray>\n";
-}
-
-void finish(std::ofstream& out, const std::string& path)
-{
-    out.flush();
-    if (!out) throw InputError(concat("failed while writing '", path, "' (disk full?)"));
 }
 
 std::string numbered(const std::string& stem, int index)
@@ -68,24 +56,12 @@ void write_particles_vtp(const World& world, const std::string& path)
     out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) out << i + 1 << '\n';
     out << "</DataArray>\n</Verts>\n</Piece>\n</PolyData>\n</VTKFile>\n";
-    finish(out, path);
+    finish_writing(out, path);
 }
 
 void write_mesh_vtp(const MeshWall& wall, const std::string& path)
 {
-    const auto& verts = wall.vertices_world_m();
-    const auto& tris = wall.mesh().triangles();
-    std::ofstream out = open_for_writing(path);
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-        << "<Piece NumberOfPoints=\"" << verts.size() << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\""
-        << tris.size() << "\">\n<Points>\n";
-    write_vec3_array(out, "position_m", verts);
-    out << "</Points>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& t : tris) out << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
-    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t k = 0; k < tris.size(); ++k) out << 3 * (k + 1) << '\n';
-    out << "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
-    finish(out, path);
+    meshes::write_surface_vtp(path, wall.vertices_world_m(), wall.mesh().triangles());
 }
 
 void PvdCollection::add(double time_s, const std::string& file)
@@ -97,7 +73,7 @@ void PvdCollection::add(double time_s, const std::string& file)
         out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n";
         for (const auto& [t, f] : entries_) out << "<DataSet timestep=\"" << t << "\" part=\"0\" file=\"" << f << "\"/>\n";
         out << "</Collection>\n</VTKFile>\n";
-        finish(out, tmp);
+        finish_writing(out, tmp);
     }
     std::filesystem::rename(tmp, path_);  // atomic: a reader never sees half a collection
 }
@@ -145,7 +121,7 @@ void WorldCsv::write_row(const World& world)
         out_ << ',' << f.x << ',' << f.y << ',' << f.z;
     }
     out_ << '\n';
-    finish(out_, path_);
+    finish_writing(out_, path_);
 }
 
 }  // namespace dipper::dem

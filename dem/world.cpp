@@ -317,6 +317,7 @@ void World::finish_step(double dt_s)
         r.triangle_id = c.triangle;
         r.particle_index = static_cast<std::int32_t>(c.particle);
         r.particle_mass_kg = particles_.mass_kg[c.particle];
+        r.first_step = c.first_step;
     }
     if (consumer_) consumer_(records_, time_s_, dt_s);
 
@@ -747,6 +748,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         c.normal = h.normal;
         c.point = h.point;
         c.overlap_m = h.overlap;
+        c.first_step = true;
         int best = -1;
         double best_dot = 0.9;  // within about 25 degrees: the same contact moving over the surface
         for (std::uint32_t o = old_begin; o < old_end; ++o) {
@@ -759,6 +761,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         if (best >= 0) {
             used |= 1u << best;
             c.history = wall_contacts_[old_begin + static_cast<std::uint32_t>(best)].history;
+            c.first_step = false;
         }
 
         const WallRef& ref = walls_[static_cast<std::size_t>(h.wall)];

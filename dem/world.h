@@ -113,6 +113,7 @@ private:
         std::int32_t wall, triangle;
         Vec3 normal, point, relative_displacement_m;
         double overlap_m;
+        bool first_step;  ///< no contact of last step continues into this one
         ContactHistory history;
         ContactForces forces;
     };
