@@ -6,6 +6,8 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libassimp-dev        # mesh files (STL, OBJ, PLY)
+  libbullet-dev        # rigid rocks and the shovel (double-precision libraries)
+  libeigen3-dev        # small dense linear algebra (principal axes of inertia)
   catch2               # unit and analytic tests (v2.13)
   libbenchmark-dev     # micro-benchmarks
   libomp-dev           # OpenMP runtime headers for clang users; g++ ships libgomp

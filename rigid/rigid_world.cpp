@@ -1,0 +1,419 @@
+#include "rigid/rigid_world.h"
+
+#include "core/errors.h"
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionDispatch/btInternalEdgeUtility.h>
+
+#include <algorithm>
+#include <cmath>
+
+static_assert(sizeof(btScalar) == sizeof(double), "dipper links Bullet's double-precision build (BT_USE_DOUBLE_PRECISION)");
+
+namespace dipper::rigid {
+
+namespace {
+
+btVector3 to_bt(const Vec3& v) { return {v.x, v.y, v.z}; }
+Vec3 from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+btMatrix3x3 to_bt(const Mat3& m)
+{
+    return {m.m[0][0], m.m[0][1], m.m[0][2], m.m[1][0], m.m[1][1], m.m[1][2], m.m[2][0], m.m[2][1], m.m[2][2]};
+}
+
+Mat3 from_bt(const btMatrix3x3& b)
+{
+    Mat3 m;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m.m[i][j] = b[i][j];
+    return m;
+}
+
+/// Friction and restitution per material pair; Bullet's contact callback reads it through the bodies'
+/// user pointer.
+struct MaterialPairs {
+    std::vector<std::string> names;
+    std::vector<double> friction, restitution;  // names x names
+    std::vector<bool> set;
+    std::size_t index(int a, int b) const { return static_cast<std::size_t>(a) * names.size() + static_cast<std::size_t>(b); }
+};
+
+// Bullet calls this for every new contact point of a body with CF_CUSTOM_MATERIAL_CALLBACK: the pair's own
+// friction and restitution replace Bullet's product rule, and contacts on triangle meshes get the face
+// normal at internal edges instead of an edge normal.
+bool pair_material_callback(btManifoldPoint& cp, const btCollisionObjectWrapper* w0, int part0, int index0,
+                            const btCollisionObjectWrapper* w1, int part1, int index1)
+{
+    const btCollisionObject* a = w0->getCollisionObject();
+    const btCollisionObject* b = w1->getCollisionObject();
+    const auto* pairs = static_cast<const MaterialPairs*>(a->getUserPointer() ? a->getUserPointer() : b->getUserPointer());
+    if (!pairs) return false;
+    const std::size_t k = pairs->index(a->getUserIndex(), b->getUserIndex());
+    cp.m_combinedFriction = pairs->friction[k];
+    cp.m_combinedRestitution = pairs->restitution[k];
+    if (w0->getCollisionShape()->getShapeType() == TRIANGLE_SHAPE_PROXYTYPE)
+        btAdjustInternalEdgeContacts(cp, w0, w1, part0, index0);
+    else if (w1->getCollisionShape()->getShapeType() == TRIANGLE_SHAPE_PROXYTYPE)
+        btAdjustInternalEdgeContacts(cp, w1, w0, part1, index1);
+    return true;
+}
+
+}  // namespace
+
+struct RigidWorld::Impl {
+    struct Body {
+        std::string name;
+        int material = 0;
+        bool kinematic = false;
+        double margin_m = 0.0;
+        std::vector<int> indices;
+        std::vector<btScalar> vertices;
+        std::unique_ptr<btTriangleIndexVertexArray> mesh_data;
+        std::unique_ptr<btTriangleInfoMap> edge_info;
+        std::unique_ptr<btCollisionShape> shape;
+        std::unique_ptr<btDefaultMotionState> motion;
+        std::unique_ptr<btRigidBody> body;
+    };
+
+    explicit Impl(const RigidSettings& s) : settings(s)
+    {
+        world.setGravity(to_bt(s.gravity_m_per_s2));
+        btContactSolverInfo& info = world.getSolverInfo();
+        info.m_numIterations = s.solver_iterations;
+        info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+        info.m_splitImpulse = 1;
+        info.m_splitImpulsePenetrationThreshold = -s.split_impulse_threshold_m;
+    }
+    ~Impl()
+    {
+        for (auto& b : bodies) world.removeRigidBody(b->body.get());
+    }
+
+    RigidSettings settings;
+    btDefaultCollisionConfiguration config;
+    btCollisionDispatcher dispatcher{&config};
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
+    std::vector<std::unique_ptr<Body>> bodies;
+    MaterialPairs pairs;
+    std::size_t checked_bodies = 0;  // bodies whose material pairs have been checked
+    double time_s = 0.0;
+    std::vector<Vec3> contact_force;
+
+    Body& body(BodyId id, const char* what)
+    {
+        if (id < 0 || static_cast<std::size_t>(id) >= bodies.size())
+            throw InputError(concat(what, ": no body ", id, "; the world has bodies 0..", static_cast<int>(bodies.size()) - 1));
+        return *bodies[static_cast<std::size_t>(id)];
+    }
+    void check_material(int m, const std::string& where) const
+    {
+        if (m < 0 || static_cast<std::size_t>(m) >= pairs.names.size())
+            throw InputError(concat(where, ": material index ", m, " is not defined; the world has ", pairs.names.size(), " materials"));
+    }
+    /// Every pair a rock can meet must have coefficients: checked before the first step with new bodies.
+    void check_pairs()
+    {
+        for (std::size_t i = 0; i < bodies.size(); ++i) {
+            if (bodies[i]->body->getInvMass() == 0.0) continue;
+            for (std::size_t j = 0; j < bodies.size(); ++j) {
+                if (j < checked_bodies && i < checked_bodies) continue;
+                const int a = bodies[i]->material, b = bodies[j]->material;
+                if (!pairs.set[pairs.index(a, b)])
+                    throw InputError(concat("rigid bodies '", bodies[i]->name, "' and '", bodies[j]->name,
+                                            "': no friction and restitution for the material pair ", pairs.names[static_cast<std::size_t>(a)],
+                                            "-", pairs.names[static_cast<std::size_t>(b)], "; set it with set_pair"));
+            }
+        }
+        checked_bodies = bodies.size();
+    }
+
+    BodyId insert(std::unique_ptr<Body> b, double mass, const btVector3& inertia, const btTransform& pose)
+    {
+        b->motion = std::make_unique<btDefaultMotionState>(pose);
+        btRigidBody::btRigidBodyConstructionInfo info(mass, b->motion.get(), b->shape.get(), inertia);
+        info.m_friction = 0.5;  // replaced per pair in the contact callback
+        b->body = std::make_unique<btRigidBody>(info);
+        b->body->setActivationState(DISABLE_DEACTIVATION);  // a resting rock must still feel new loads
+        b->body->setCollisionFlags(b->body->getCollisionFlags() | btCollisionObject::CF_CUSTOM_MATERIAL_CALLBACK |
+                                   (b->kinematic ? btCollisionObject::CF_KINEMATIC_OBJECT : 0));
+        b->body->setUserPointer(&pairs);
+        b->body->setUserIndex(b->material);
+        const BodyId id = static_cast<BodyId>(bodies.size());
+        b->body->setUserIndex2(id);
+        world.addRigidBody(b->body.get());
+        bodies.push_back(std::move(b));
+        contact_force.resize(bodies.size());
+        return id;
+    }
+
+    BodyId insert_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name, bool kinematic,
+                       const Mat3& rotation, const Vec3& translation)
+    {
+        check_material(material, concat("mesh '", name, "'"));
+        if (mesh.triangle_count() == 0) throw InputError(concat("mesh '", name, "' has no triangles"));
+        auto b = std::make_unique<Body>();
+        b->name = name;
+        b->material = material;
+        b->kinematic = kinematic;
+        for (const auto& t : mesh.triangles()) b->indices.insert(b->indices.end(), {int(t[0]), int(t[1]), int(t[2])});
+        for (const Vec3& v : mesh.vertices_m()) b->vertices.insert(b->vertices.end(), {v.x, v.y, v.z});
+        b->mesh_data = std::make_unique<btTriangleIndexVertexArray>(
+            static_cast<int>(mesh.triangle_count()), b->indices.data(), static_cast<int>(3 * sizeof(int)),
+            static_cast<int>(mesh.vertex_count()), b->vertices.data(), static_cast<int>(3 * sizeof(btScalar)));
+        auto shape = std::make_unique<btBvhTriangleMeshShape>(b->mesh_data.get(), true);
+        b->edge_info = std::make_unique<btTriangleInfoMap>();
+        btGenerateInternalEdgeInfo(shape.get(), b->edge_info.get());
+        b->shape = std::move(shape);
+        return insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform(to_bt(rotation), to_bt(translation)));
+    }
+};
+
+RigidWorld::RigidWorld(RigidSettings settings)
+{
+    require_positive(settings.step_s, "step_s", "rigid settings");
+    if (settings.solver_iterations < 1 || settings.solver_iterations > 1000)
+        throw InputError(concat("rigid settings: solver_iterations is ", settings.solver_iterations, "; expected 1..1000"));
+    require_non_negative(settings.split_impulse_threshold_m, "split_impulse_threshold_m", "rigid settings");
+    require_positive(settings.rock_margin_m, "rock_margin_m", "rigid settings");
+    require_in_range(settings.rock_margin_fraction, 1e-3, 0.5, "rock_margin_fraction", "rigid settings");
+    if (!is_finite(settings.gravity_m_per_s2)) throw InputError("rigid settings: gravity is not finite");
+    impl_ = std::make_unique<Impl>(settings);
+    gContactAddedCallback = pair_material_callback;
+}
+
+RigidWorld::~RigidWorld() = default;
+RigidWorld::RigidWorld(RigidWorld&&) noexcept = default;
+RigidWorld& RigidWorld::operator=(RigidWorld&&) noexcept = default;
+
+int RigidWorld::add_material(const std::string& name)
+{
+    MaterialPairs& p = impl_->pairs;
+    if (std::find(p.names.begin(), p.names.end(), name) != p.names.end())
+        throw InputError(concat("rigid material '", name, "' defined twice"));
+    const std::size_t old = p.names.size(), n = old + 1;
+    std::vector<double> f(n * n, 0.0), e(n * n, 0.0);
+    std::vector<bool> set(n * n, false);
+    for (std::size_t i = 0; i < old; ++i)
+        for (std::size_t j = 0; j < old; ++j) {
+            f[i * n + j] = p.friction[i * old + j];
+            e[i * n + j] = p.restitution[i * old + j];
+            set[i * n + j] = p.set[i * old + j];
+        }
+    p.names.push_back(name);
+    p.friction = std::move(f);
+    p.restitution = std::move(e);
+    p.set = std::move(set);
+    return static_cast<int>(old);
+}
+
+int RigidWorld::material_index(const std::string& name) const
+{
+    const auto& m = impl_->pairs.names;
+    const auto it = std::find(m.begin(), m.end(), name);
+    if (it == m.end()) {
+        std::string known;
+        for (const auto& n : m) known += (known.empty() ? "" : ", ") + n;
+        throw InputError(concat("rigid material '", name, "' is not defined; defined: ", known.empty() ? "(none)" : known));
+    }
+    return static_cast<int>(it - m.begin());
+}
+
+void RigidWorld::set_pair(const std::string& a, const std::string& b, double friction, double restitution)
+{
+    const std::string where = concat("rigid pair ", a, "-", b);
+    require_non_negative(friction, "friction", where);
+    require_in_range(restitution, 0.0, 1.0, "restitution", where);
+    MaterialPairs& p = impl_->pairs;
+    const int i = material_index(a), j = material_index(b);
+    for (const std::size_t k : {p.index(i, j), p.index(j, i)}) {
+        p.friction[k] = friction;
+        p.restitution[k] = restitution;
+        p.set[k] = true;
+    }
+}
+
+double RigidWorld::pair_friction(int a, int b) const { return impl_->pairs.friction[impl_->pairs.index(a, b)]; }
+double RigidWorld::pair_restitution(int a, int b) const { return impl_->pairs.restitution[impl_->pairs.index(a, b)]; }
+
+BodyId RigidWorld::add_ground_plane(double height_m, int material, const std::string& name)
+{
+    impl_->check_material(material, concat("ground '", name, "'"));
+    auto b = std::make_unique<Impl::Body>();
+    b->name = name;
+    b->material = material;
+    b->shape = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), height_m);
+    return impl_->insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform::getIdentity());
+}
+
+BodyId RigidWorld::add_static_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
+                                   const Mat3& rotation, const Vec3& translation_m)
+{
+    return impl_->insert_mesh(mesh, material, name, false, rotation, translation_m);
+}
+
+BodyId RigidWorld::add_kinematic_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
+                                      const Mat3& rotation, const Vec3& translation_m)
+{
+    return impl_->insert_mesh(mesh, material, name, true, rotation, translation_m);
+}
+
+void RigidWorld::set_kinematic_pose(BodyId id, const Mat3& rotation, const Vec3& translation_m)
+{
+    Impl::Body& b = impl_->body(id, "set_kinematic_pose");
+    if (!b.kinematic) throw InputError(concat("set_kinematic_pose: body '", b.name, "' is not a kinematic mesh"));
+    b.motion->setWorldTransform(btTransform(to_bt(rotation), to_bt(translation_m)));
+}
+
+BodyId RigidWorld::add_rock(const ConvexPolyhedron& shape, double density, int material, const Vec3& position_m,
+                            const Mat3& rotation, const Vec3& velocity, const Vec3& angular_velocity)
+{
+    const std::string where = concat("rock ", impl_->bodies.size(), " (", shape.source(), ")");
+    impl_->check_material(material, where);
+    require_positive(density, "density_kg_per_m3", where);
+    if (!is_finite(position_m) || !is_finite(velocity) || !is_finite(angular_velocity))
+        throw InputError(concat(where, ": position or velocity is not finite"));
+    const double size = shape.equivalent_diameter_m();
+    const Mat3 inertia = shape.inertia_about_centroid(density);
+    const double scale = std::max({inertia.m[0][0], inertia.m[1][1], inertia.m[2][2]});
+    const double off = std::max({std::abs(inertia.m[0][1]), std::abs(inertia.m[0][2]), std::abs(inertia.m[1][2])});
+    if (norm(shape.centroid_m()) > 1e-9 * size || off > 1e-9 * scale)
+        throw InputError(concat(where, ": the shape is not in its principal frame (centroid ", norm(shape.centroid_m()),
+                                " m from the origin, largest product of inertia ", off / scale,
+                                " of the moments); pass shape.in_principal_frame()"));
+
+    auto b = std::make_unique<Impl::Body>();
+    b->name = concat("rock ", impl_->bodies.size());
+    b->material = material;
+    b->margin_m = std::min(impl_->settings.rock_margin_m, impl_->settings.rock_margin_fraction * shape.inner_radius_m());
+    const std::vector<Vec3> core = shape.shrunk(b->margin_m).vertices_m();
+    auto hull = std::make_unique<btConvexHullShape>();
+    for (const Vec3& v : core) hull->addPoint(to_bt(v), false);
+    hull->recalcLocalAabb();
+    hull->setMargin(b->margin_m);
+    b->shape = std::move(hull);
+    const double mass = density * shape.volume_m3();
+    const btVector3 moments(inertia.m[0][0], inertia.m[1][1], inertia.m[2][2]);
+    const BodyId id = impl_->insert(std::move(b), mass, moments, btTransform(to_bt(rotation), to_bt(position_m)));
+    btRigidBody* body = impl_->bodies.back()->body.get();
+    body->setLinearVelocity(to_bt(velocity));
+    body->setAngularVelocity(to_bt(angular_velocity));
+    return id;
+}
+
+std::size_t RigidWorld::body_count() const { return impl_->bodies.size(); }
+const std::string& RigidWorld::body_name(BodyId id) const { return impl_->body(id, "body_name").name; }
+
+double RigidWorld::mass_kg(BodyId id) const
+{
+    const btRigidBody* b = impl_->body(id, "mass_kg").body.get();
+    return b->getInvMass() > 0.0 ? 1.0 / b->getInvMass() : 0.0;
+}
+
+double RigidWorld::margin_m(BodyId id) const { return impl_->body(id, "margin_m").margin_m; }
+
+BodyState RigidWorld::state(BodyId id) const
+{
+    const btRigidBody* b = impl_->body(id, "state").body.get();
+    const btTransform& t = b->getWorldTransform();
+    return {from_bt(t.getOrigin()), from_bt(t.getBasis()), from_bt(b->getLinearVelocity()), from_bt(b->getAngularVelocity())};
+}
+
+void RigidWorld::apply_force(BodyId id, const Vec3& force, const Vec3& point)
+{
+    Impl::Body& b = impl_->body(id, "apply_force");
+    if (!is_finite(force) || !is_finite(point))
+        throw SimulationError(concat("apply_force on '", b.name, "': force or point is not finite at t = ", impl_->time_s, " s"));
+    if (b.body->getInvMass() == 0.0) return;  // static and kinematic bodies do not respond to forces
+    b.body->applyForce(to_bt(force), to_bt(point) - b.body->getCenterOfMassPosition());
+}
+
+void RigidWorld::step()
+{
+    const double dt = impl_->settings.step_s;
+    if (impl_->checked_bodies != impl_->bodies.size()) impl_->check_pairs();
+    impl_->world.stepSimulation(dt, 0);  // maxSubSteps = 0: exactly one step of dt, no interpolation
+    impl_->time_s += dt;
+
+    std::fill(impl_->contact_force.begin(), impl_->contact_force.end(), Vec3{});
+    btDispatcher& d = impl_->dispatcher;
+    for (int q = 0; q < d.getNumManifolds(); ++q) {
+        const btPersistentManifold* m = d.getManifoldByIndexInternal(q);
+        const int a = m->getBody0()->getUserIndex2(), b = m->getBody1()->getUserIndex2();
+        for (int k = 0; k < m->getNumContacts(); ++k) {
+            const btManifoldPoint& p = m->getContactPoint(k);
+            const Vec3 on_a = (from_bt(p.m_normalWorldOnB) * p.m_appliedImpulse + from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
+                               from_bt(p.m_lateralFrictionDir2) * p.m_appliedImpulseLateral2) * (1.0 / dt);
+            impl_->contact_force[static_cast<std::size_t>(a)] += on_a;
+            impl_->contact_force[static_cast<std::size_t>(b)] -= on_a;
+        }
+    }
+    for (const auto& b : impl_->bodies) {
+        const btRigidBody* body = b->body.get();
+        if (!is_finite(from_bt(body->getCenterOfMassPosition())) || !is_finite(from_bt(body->getLinearVelocity())))
+            throw SimulationError(concat("rigid body '", b->name, "' has a non-finite position or velocity at t = ",
+                                         impl_->time_s, " s; try a smaller step than ", dt, " s"));
+    }
+}
+
+double RigidWorld::time_s() const { return impl_->time_s; }
+const RigidSettings& RigidWorld::settings() const { return impl_->settings; }
+
+Vec3 RigidWorld::contact_force_N(BodyId id) const
+{
+    impl_->body(id, "contact_force_N");
+    return impl_->contact_force[static_cast<std::size_t>(id)];
+}
+
+std::size_t RigidWorld::contact_point_count() const
+{
+    std::size_t n = 0;
+    for (int q = 0; q < impl_->dispatcher.getNumManifolds(); ++q)
+        n += static_cast<std::size_t>(impl_->dispatcher.getManifoldByIndexInternal(q)->getNumContacts());
+    return n;
+}
+
+std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int32_t surface_id) const
+{
+    impl_->body(surface, "surface_contacts");
+    const double dt = impl_->settings.step_s;
+    std::vector<ContactRecord> out;
+    btDispatcher& d = impl_->dispatcher;
+    for (int q = 0; q < d.getNumManifolds(); ++q) {
+        const btPersistentManifold* m = d.getManifoldByIndexInternal(q);
+        const bool surface_is_a = m->getBody0()->getUserIndex2() == surface;
+        const bool surface_is_b = m->getBody1()->getUserIndex2() == surface;
+        if (!surface_is_a && !surface_is_b) continue;
+        const auto* other = btRigidBody::upcast(surface_is_a ? m->getBody1() : m->getBody0());
+        const auto* self = btRigidBody::upcast(surface_is_a ? m->getBody0() : m->getBody1());
+        if (!other || other->getInvMass() == 0.0) continue;  // rocks only
+        for (int k = 0; k < m->getNumContacts(); ++k) {
+            const btManifoldPoint& p = m->getContactPoint(k);
+            const double sign = surface_is_b ? 1.0 : -1.0;  // the normal points from B to A
+            const Vec3 n = from_bt(p.m_normalWorldOnB) * sign;
+            const Vec3 friction_on_a = (from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
+                                        from_bt(p.m_lateralFrictionDir2) * p.m_appliedImpulseLateral2) * (1.0 / dt);
+            ContactRecord r;
+            r.point_world = from_bt(surface_is_b ? p.getPositionWorldOnB() : p.getPositionWorldOnA());
+            r.normal_world = n;
+            r.normal_force_N = p.m_appliedImpulse / dt;
+            r.tangential_force_N = friction_on_a * sign;
+            const btVector3 at = surface_is_b ? p.getPositionWorldOnA() : p.getPositionWorldOnB();
+            const btVector3 v_other = other->getVelocityInLocalPoint(at - other->getCenterOfMassPosition());
+            const btVector3 v_self = self->getVelocityInLocalPoint(to_bt(r.point_world) - self->getCenterOfMassPosition());
+            r.relative_displacement_m = from_bt(v_other - v_self) * dt;
+            r.overlap_m = std::max(0.0, -p.getDistance());
+            r.surface_id = surface_id;
+            r.triangle_id = surface_is_b ? p.m_index1 : p.m_index0;
+            r.particle_index = other->getUserIndex2();
+            r.particle_mass_kg = 1.0 / other->getInvMass();
+            r.first_step = p.getLifeTime() <= 1;
+            out.push_back(r);
+        }
+    }
+    return out;
+}
+
+}  // namespace dipper::rigid

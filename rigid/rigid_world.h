@@ -1,0 +1,103 @@
+// Rigid bodies on Bullet (double precision): polyhedral rocks, static and moving machine surfaces, and the
+// contacts between them. Bullet stays inside this module: nothing here names a Bullet type.
+#pragma once
+
+#include "core/contact_record.h"
+#include "core/vec3.h"
+#include "meshes/triangle_mesh.h"
+#include "rigid/convex_polyhedron.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dipper::rigid {
+
+using BodyId = int;
+
+/// How the rigid world steps. The defaults are the ones the verification tests justify (docs/rigid.md).
+struct RigidSettings {
+    Vec3 gravity_m_per_s2{0.0, 0.0, -9.81};
+    double step_s = 1e-3;
+    int solver_iterations = 10;
+    /// Overlap that Bullet corrects inside the contact impulse; deeper overlaps are pushed apart by a
+    /// separate position correction that adds no momentum. 0: contact impulses carry physical loads only.
+    double split_impulse_threshold_m = 0.0;
+    /// Collision margin of rocks: at most rock_margin_m and at most rock_margin_fraction of the rock's inner
+    /// radius. The hull is shrunk by the margin first, so the rounded shape Bullet sees has the rock's true
+    /// faces; only its sharpest corners are rounded (tests: volume within 1 %, extents within 2 %).
+    double rock_margin_m = 0.02;
+    double rock_margin_fraction = 0.05;
+};
+
+/// Position, orientation and velocities of a body's centre of mass, world frame.
+struct BodyState {
+    Vec3 position_m;
+    Mat3 rotation;
+    Vec3 velocity_m_per_s;
+    Vec3 angular_velocity_rad_per_s;
+};
+
+class RigidWorld {
+public:
+    explicit RigidWorld(RigidSettings settings = {});
+    ~RigidWorld();
+    RigidWorld(RigidWorld&&) noexcept;
+    RigidWorld& operator=(RigidWorld&&) noexcept;
+
+    // ---- materials: contact friction and restitution per pair (symmetric), no product rule
+    int add_material(const std::string& name);
+    int material_index(const std::string& name) const;
+    void set_pair(const std::string& a, const std::string& b, double friction, double restitution);
+    double pair_friction(int a, int b) const;
+    double pair_restitution(int a, int b) const;
+
+    // ---- bodies
+    /// The plane z = height_m, solid below.
+    BodyId add_ground_plane(double height_m, int material, const std::string& name);
+    /// A fixed triangle-mesh surface, placed by rotation and translation.
+    BodyId add_static_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
+                           const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
+    /// A triangle-mesh surface moved from outside (a machine part): set_kinematic_pose before each step
+    /// gives its pose at the end of that step; Bullet sees the finite-difference velocity.
+    BodyId add_kinematic_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
+                              const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
+    void set_kinematic_pose(BodyId body, const Mat3& rotation, const Vec3& translation_m);
+    /// A rock: `shape` in its principal frame (ConvexPolyhedron::in_principal_frame, or generate_rock), placed
+    /// with its centroid at `position_m`. Mass and inertia come from the shape and density.
+    BodyId add_rock(const ConvexPolyhedron& shape, double density_kg_per_m3, int material, const Vec3& position_m,
+                    const Mat3& rotation = Mat3::identity(), const Vec3& velocity_m_per_s = {},
+                    const Vec3& angular_velocity_rad_per_s = {});
+
+    std::size_t body_count() const;
+    const std::string& body_name(BodyId body) const;
+    double mass_kg(BodyId body) const;  ///< 0 for static and kinematic bodies
+    BodyState state(BodyId body) const;
+    /// The collision margin a rock was given, m (0 for meshes and planes).
+    double margin_m(BodyId body) const;
+
+    /// Adds a force acting at a world point during the next step only (Bullet clears forces each step).
+    void apply_force(BodyId body, const Vec3& force_N, const Vec3& point_world_m);
+
+    // ---- stepping
+    /// Exactly one Bullet step of settings().step_s: no sub-steps, no interpolation.
+    void step();
+    double time_s() const;
+    const RigidSettings& settings() const;
+
+    // ---- contacts of the last step
+    /// Sum of contact forces (impulses / step) on a body during the last step, N.
+    Vec3 contact_force_N(BodyId body) const;
+    /// Every contact point on `surface` during the last step, as a record: the point on the surface, the
+    /// normal from the surface towards the other body, normal and friction force (impulse / step), the
+    /// other body's contact point displacement relative to the surface over the step, and the surface's
+    /// triangle. `surface_id` is written into the records. Rocks only (not plane-plane or mesh-mesh).
+    std::vector<ContactRecord> surface_contacts(BodyId surface, std::int32_t surface_id) const;
+    std::size_t contact_point_count() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dipper::rigid
