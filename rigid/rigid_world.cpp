@@ -1,6 +1,7 @@
 #include "rigid/rigid_world.h"
 
 #include "core/errors.h"
+#include "meshes/triangle_locator.h"
 
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionDispatch/btInternalEdgeUtility.h>
@@ -72,6 +73,9 @@ struct RigidWorld::Impl {
         std::unique_ptr<btTriangleIndexVertexArray> mesh_data;
         std::unique_ptr<btTriangleInfoMap> edge_info;
         std::unique_ptr<btCollisionShape> shape;
+        std::vector<std::unique_ptr<btCollisionShape>> children;  // of a compound shape
+        std::unique_ptr<meshes::TriangleLocator> locator;          // of the last wear mesh asked for
+        const meshes::TriangleMesh* located_mesh = nullptr;
         std::unique_ptr<btDefaultMotionState> motion;
         std::unique_ptr<btRigidBody> body;
     };
@@ -260,6 +264,30 @@ BodyId RigidWorld::add_kinematic_mesh(const meshes::TriangleMesh& mesh, int mate
     return impl_->insert_mesh(mesh, material, name, true, rotation, translation_m);
 }
 
+BodyId RigidWorld::add_plates(const std::vector<Plate>& plates, int material, const std::string& name, bool kinematic,
+                              const Mat3& rotation, const Vec3& translation_m)
+{
+    impl_->check_material(material, concat("part '", name, "'"));
+    if (plates.empty()) throw InputError(concat("part '", name, "' has no plates: a body needs a collision shape"));
+    auto b = std::make_unique<Impl::Body>();
+    b->name = name;
+    b->material = material;
+    b->kinematic = kinematic;
+    auto compound = std::make_unique<btCompoundShape>();
+    for (std::size_t k = 0; k < plates.size(); ++k) {
+        const Plate& p = plates[k];
+        const Vec3& h = p.half_extents_m;
+        if (!(h.x > 0.0 && h.y > 0.0 && h.z > 0.0) || !is_finite(h) || !is_finite(p.centre_m))
+            throw InputError(concat("part '", name, "', plate ", k, ": half extents (", h.x, ", ", h.y, ", ", h.z,
+                                    ") m; expected finite and > 0"));
+        auto box = std::make_unique<btBoxShape>(to_bt(h));  // the margin lies inside a box: its size is exact
+        compound->addChildShape(btTransform(to_bt(p.rotation), to_bt(p.centre_m)), box.get());
+        b->children.push_back(std::move(box));
+    }
+    b->shape = std::move(compound);
+    return impl_->insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform(to_bt(rotation), to_bt(translation_m)));
+}
+
 void RigidWorld::set_kinematic_pose(BodyId id, const Mat3& rotation, const Vec3& translation_m)
 {
     Impl::Body& b = impl_->body(id, "set_kinematic_pose");
@@ -375,9 +403,15 @@ std::size_t RigidWorld::contact_point_count() const
     return n;
 }
 
-std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int32_t surface_id) const
+std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int32_t surface_id,
+                                                        const meshes::TriangleMesh* wear_mesh) const
 {
-    impl_->body(surface, "surface_contacts");
+    Impl::Body& part = impl_->body(surface, "surface_contacts");
+    if (wear_mesh && part.located_mesh != wear_mesh) {
+        part.locator = std::make_unique<meshes::TriangleLocator>(*wear_mesh);
+        part.located_mesh = wear_mesh;
+    }
+    const btTransform to_part = part.body->getWorldTransform().inverse();
     const double dt = impl_->settings.step_s;
     std::vector<ContactRecord> out;
     btDispatcher& d = impl_->dispatcher;
@@ -407,6 +441,8 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
             r.overlap_m = std::max(0.0, -p.getDistance());
             r.surface_id = surface_id;
             r.triangle_id = surface_is_b ? p.m_index1 : p.m_index0;
+            if (part.body->getCollisionShape()->getShapeType() != TRIANGLE_MESH_SHAPE_PROXYTYPE) r.triangle_id = -1;
+            if (wear_mesh) r.triangle_id = part.locator->nearest(from_bt(to_part * to_bt(r.point_world))).triangle;
             r.particle_index = other->getUserIndex2();
             r.particle_mass_kg = 1.0 / other->getInvMass();
             r.first_step = p.getLifeTime() <= 1;

@@ -30,6 +30,13 @@ struct RigidSettings {
     double rock_margin_fraction = 0.05;
 };
 
+/// A flat plate with thickness, in a part's frame: the convex solids Bullet uses for machine parts.
+struct Plate {
+    Vec3 centre_m;
+    Vec3 half_extents_m;
+    Mat3 rotation;  ///< plate frame to part frame
+};
+
 /// Position, orientation and velocities of a body's centre of mass, world frame.
 struct BodyState {
     Vec3 position_m;
@@ -62,6 +69,9 @@ public:
     /// gives its pose at the end of that step; Bullet sees the finite-difference velocity.
     BodyId add_kinematic_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
                               const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
+    /// A part made of plates (boxes), fixed or moved from outside like a kinematic mesh.
+    BodyId add_plates(const std::vector<Plate>& plates, int material, const std::string& name, bool kinematic,
+                      const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
     void set_kinematic_pose(BodyId body, const Mat3& rotation, const Vec3& translation_m);
     /// A rock: `shape` in its principal frame (ConvexPolyhedron::in_principal_frame, or generate_rock), placed
     /// with its centroid at `position_m`. Mass and inertia come from the shape and density.
@@ -92,7 +102,10 @@ public:
     /// normal from the surface towards the other body, normal and friction force (impulse / step), the
     /// other body's contact point displacement relative to the surface over the step, and the surface's
     /// triangle. `surface_id` is written into the records. Rocks only (not plane-plane or mesh-mesh).
-    std::vector<ContactRecord> surface_contacts(BodyId surface, std::int32_t surface_id) const;
+    /// With `wear_mesh` (the part's surface mesh in its own frame) each record's triangle is the wear-mesh
+    /// triangle nearest to the contact point; without it, the Bullet mesh's own triangle (-1 for plates).
+    std::vector<ContactRecord> surface_contacts(BodyId surface, std::int32_t surface_id,
+                                                const meshes::TriangleMesh* wear_mesh = nullptr) const;
     std::size_t contact_point_count() const;
 
 private:
