@@ -1,10 +1,13 @@
 // Triangle meshes: closest-point features, topology, inside tests, file loading.
+#include "meshes/mesh_builder.h"
 #include "meshes/mesh_io.h"
+#include "meshes/triangle_locator.h"
 #include "meshes/triangle_mesh.h"
 
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <random>
 
 using namespace dipper;
 using namespace dipper::meshes;
@@ -82,4 +85,26 @@ TEST_CASE("STL, OBJ and PLY files load into the same mesh", "[meshes][unit]")
     CHECK(from_ply.total_area_m2() == Approx(1.0).epsilon(1e-12));
     CHECK(from_obj.edge_count() == 5);
     CHECK(from_ply.edge_count() == 5);
+}
+
+TEST_CASE("the triangle locator finds the same nearest triangle as a search of all triangles", "[meshes][unit]")
+{
+    const meshes::TriangleMesh box = meshes::make_open_box_mesh(2.0, 1.5, 0.8, 0.075);
+    const meshes::TriangleLocator locator(box);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> x(-0.5, 2.5), y(-0.5, 2.0), z(-0.5, 1.3);
+    for (int k = 0; k < 500; ++k) {
+        const Vec3 p{x(rng), y(rng), z(rng)};
+        double best = 1e300;
+        for (const auto& t : box.triangles()) {
+            const auto c = meshes::closest_point_on_triangle(p, box.vertices_m()[t[0]], box.vertices_m()[t[1]], box.vertices_m()[t[2]]);
+            best = std::min(best, c.distance_squared);
+        }
+        const auto hit = locator.nearest(p);
+        CAPTURE(p.x, p.y, p.z);
+        REQUIRE(hit.triangle >= 0);
+        CHECK(hit.distance_m == Approx(std::sqrt(best)).margin(1e-12));
+    }
+    // a point far outside the grid still finds its nearest triangle
+    CHECK(locator.nearest({10.0, 0.5, 0.4}).distance_m == Approx(8.0).margin(1e-12));
 }
