@@ -123,7 +123,7 @@ struct RigidWorld::Impl {
         for (std::size_t i = 0; i < bodies.size(); ++i) {
             if (bodies[i]->body->getInvMass() == 0.0) continue;
             for (std::size_t j = 0; j < bodies.size(); ++j) {
-                if (j < checked_bodies && i < checked_bodies) continue;
+                if (j == i || (j < checked_bodies && i < checked_bodies)) continue;
                 const int a = bodies[i]->material, b = bodies[j]->material;
                 if (!pairs.set[pairs.index(a, b)])
                     throw InputError(concat("rigid bodies '", bodies[i]->name, "' and '", bodies[j]->name,
@@ -401,6 +401,32 @@ std::size_t RigidWorld::contact_point_count() const
     for (int q = 0; q < impl_->dispatcher.getNumManifolds(); ++q)
         n += static_cast<std::size_t>(impl_->dispatcher.getManifoldByIndexInternal(q)->getNumContacts());
     return n;
+}
+
+double RigidWorld::max_penetration_m() const
+{
+    double deepest = 0.0;
+    for (int q = 0; q < impl_->dispatcher.getNumManifolds(); ++q) {
+        const btPersistentManifold* m = impl_->dispatcher.getManifoldByIndexInternal(q);
+        for (int k = 0; k < m->getNumContacts(); ++k) deepest = std::max(deepest, -m->getContactPoint(k).getDistance());
+    }
+    return deepest;
+}
+
+double RigidWorld::kinetic_energy_J() const
+{
+    double e = 0.0;
+    for (const auto& b : impl_->bodies) {
+        const btRigidBody* body = b->body.get();
+        if (body->getInvMass() == 0.0) continue;
+        const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
+        const btVector3 local_w = body->getWorldTransform().getBasis().transpose() * w;
+        const btVector3 inv = body->getInvInertiaDiagLocal();
+        double rot = 0.0;
+        for (int k = 0; k < 3; ++k) rot += (inv[k] > 0.0 ? local_w[k] * local_w[k] / inv[k] : 0.0);
+        e += 0.5 * v.length2() / body->getInvMass() + 0.5 * rot;
+    }
+    return e;
 }
 
 std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int32_t surface_id,

@@ -107,6 +107,10 @@ public:
     std::vector<ContactRecord> surface_contacts(BodyId surface, std::int32_t surface_id,
                                                 const meshes::TriangleMesh* wear_mesh = nullptr) const;
     std::size_t contact_point_count() const;
+    /// Deepest overlap among the contact points of the last step, m (0 if none overlap).
+    double max_penetration_m() const;
+    /// Kinetic energy of the dynamic bodies (rocks), J.
+    double kinetic_energy_J() const;
 
 private:
     struct Impl;

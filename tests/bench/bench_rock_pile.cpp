@@ -1,0 +1,89 @@
+// Rock piles in Bullet: cost per rock per step of a settled pile, memory, and the ground reaction against
+// the pile's weight. Rocks of the thesis' size classes (Table 1 mass fractions 300/400/600/850 mm =
+// 10/9/19/25) are dropped from a loose lattice onto the ground and settled; then steps are timed.
+// Usage: dipper_bench_rock_pile [--rocks N] [--dt S] [--settle-s S] [--steps N] [--point-count N]
+#include "rigid/rigid_world.h"
+#include "rigid/rock_generator.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace dipper;
+using namespace dipper::rigid;
+
+int main(int argc, char** argv)
+{
+    int rocks = 1000, steps = 200, point_count = 20;
+    double dt = 1e-3, settle_s = 2.0;
+    for (int k = 1; k + 1 < argc; k += 2) {
+        const std::string key = argv[k];
+        if (key == "--rocks") rocks = std::atoi(argv[k + 1]);
+        else if (key == "--dt") dt = std::atof(argv[k + 1]);
+        else if (key == "--settle-s") settle_s = std::atof(argv[k + 1]);
+        else if (key == "--steps") steps = std::atoi(argv[k + 1]);
+        else if (key == "--point-count") point_count = std::atoi(argv[k + 1]);
+        else {
+            std::fprintf(stderr, "unknown option %s\n", argv[k]);
+            return 2;
+        }
+    }
+    RigidSettings settings;
+    settings.step_s = dt;
+    RigidWorld w(settings);
+    w.add_material("rock");
+    w.add_material("ground");
+    w.set_pair("rock", "rock", 0.85, 0.0);
+    w.set_pair("rock", "ground", 0.9, 0.0);
+    const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
+
+    // size classes by count from the mass fractions (mass per rock ~ size^3)
+    const double sizes[4] = {0.3, 0.4, 0.6, 0.85}, mass_fraction[4] = {10, 9, 19, 25};
+    double weights[4], total = 0.0;
+    for (int c = 0; c < 4; ++c) total += weights[c] = mass_fraction[c] / std::pow(sizes[c], 3);
+    std::mt19937_64 rng(1);
+    std::discrete_distribution<int> pick(weights, weights + 4);
+    const int side = static_cast<int>(std::ceil(std::sqrt(rocks / 4.0)));
+    const double spacing = 1.0;
+    double weight = 0.0;
+    for (int k = 0; k < rocks; ++k) {
+        const int layer = k / (side * side), i = (k / side) % side, j = k % side;
+        const ConvexPolyhedron r = generate_rock({sizes[pick(rng)], 1.0, 2.0, point_count}, 1000 + static_cast<std::uint64_t>(k));
+        const BodyId id = w.add_rock(r, 2700.0, 0, {i * spacing, j * spacing, 0.6 + layer * spacing},
+                                     rotation_about_axis({0.0, 0.0, 1.0}, 0.37 * k));
+        weight += w.mass_kg(id) * 9.81;
+    }
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    const int settle_steps = static_cast<int>(std::lround(settle_s / dt));
+    for (int k = 0; k < settle_steps; ++k) w.step();
+    const double settle_wall = std::chrono::duration<double>(clock::now() - t0).count();
+
+    std::vector<double> per_step;
+    double reaction = 0.0;
+    for (int k = 0; k < steps; ++k) {
+        const auto a = clock::now();
+        w.step();
+        per_step.push_back(std::chrono::duration<double>(clock::now() - a).count());
+        reaction += -w.contact_force_N(ground).z;
+    }
+    std::sort(per_step.begin(), per_step.end());
+    const double median = per_step[per_step.size() / 2];
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    std::printf("rocks %d  dt %g s  settle %.1f s (%.1f s wall)\n", rocks, dt, settle_s, settle_wall);
+    std::printf("  median step %.3f ms = %.1f us per rock per step; contact points %zu\n", median * 1e3,
+                median / rocks * 1e6, w.contact_point_count());
+    std::printf("  ground reaction / weight %.5f (mean of %d steps); kinetic energy %.4g J; deepest overlap %.2f mm\n",
+                reaction / steps / weight, steps, w.kinetic_energy_J(), w.max_penetration_m() * 1e3);
+    std::printf("  peak memory %.1f MB (%.1f kB per rock)\n", usage.ru_maxrss / 1024.0, usage.ru_maxrss / static_cast<double>(rocks));
+    return 0;
+}
