@@ -18,6 +18,7 @@ public:
     void add_quad_sized(const Vec3& origin_m, const Vec3& edge_u_m, const Vec3& edge_v_m, double element_size_m);
     void add_triangle(const Vec3& a, const Vec3& b, const Vec3& c);
     void add_mesh(const TriangleMesh& mesh, const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
+    std::size_t triangle_count() const { return triangles_.size(); }
     /// The mesh, with vertices closer than `weld_m` merged.
     TriangleMesh build(const std::string& source, double weld_m = 1e-9) const;
 

@@ -9,6 +9,8 @@
 #include <array>
 #include <filesystem>
 #include <map>
+#include <algorithm>
+#include <cstring>
 #include <fstream>
 
 namespace dipper::meshes {
@@ -55,20 +57,34 @@ TriangleMesh load_triangle_mesh(const std::string& path, double scale)
 
 void write_stl(const TriangleMesh& mesh, const std::string& path, const std::string& solid_name)
 {
-    std::ofstream out(path);
+    // binary STL: 80-byte header, triangle count, then per triangle normal and corners as float32 and a
+    // 2-byte attribute (little-endian, as the format defines)
+    std::ofstream out(path, std::ios::binary);
     if (!out) throw InputError(concat("cannot write STL file '", path, "'"));
-    out.precision(12);
-    out << "solid " << solid_name << "\n";
-    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-        const Vec3& n = mesh.triangle_normal(t);
-        out << "  facet normal " << n.x << ' ' << n.y << ' ' << n.z << "\n    outer loop\n";
-        for (std::uint32_t v : mesh.triangles()[t]) {
-            const Vec3& p = mesh.vertices_m()[v];
-            out << "      vertex " << p.x << ' ' << p.y << ' ' << p.z << "\n";
+    char header[80] = {};
+    const std::string title = "dipper binary STL: " + solid_name;
+    std::copy_n(title.begin(), std::min<std::size_t>(title.size(), 79), header);
+    out.write(header, 80);
+    const auto put_u32 = [&](std::uint32_t v) {
+        const unsigned char b[4] = {static_cast<unsigned char>(v), static_cast<unsigned char>(v >> 8),
+                                    static_cast<unsigned char>(v >> 16), static_cast<unsigned char>(v >> 24)};
+        out.write(reinterpret_cast<const char*>(b), 4);
+    };
+    const auto put_vec = [&](const Vec3& v) {
+        for (const double c : {v.x, v.y, v.z}) {
+            const float f = static_cast<float>(c);
+            std::uint32_t bits;
+            std::memcpy(&bits, &f, 4);
+            put_u32(bits);
         }
-        out << "    endloop\n  endfacet\n";
+    };
+    put_u32(static_cast<std::uint32_t>(mesh.triangle_count()));
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        put_vec(mesh.triangle_normal(t));
+        for (const std::uint32_t v : mesh.triangles()[t]) put_vec(mesh.vertices_m()[v]);
+        out.write("\0\0", 2);
     }
-    out << "endsolid " << solid_name << "\n";
+    out.flush();
     if (!out) throw InputError(concat("failed while writing STL file '", path, "'"));
 }
 

@@ -12,7 +12,7 @@ namespace dipper::meshes {
 /// Throws InputError naming the file for a missing, unreadable or empty file and for degenerate triangles.
 TriangleMesh load_triangle_mesh(const std::string& path, double scale = 1.0);
 
-/// Writes an ASCII STL file (used to export generated geometry and by tests).
+/// Writes a binary STL file (float32 coordinates: about 0.5 micrometre at 4 m), as CAD tools and ParaView read it.
 void write_stl(const TriangleMesh& mesh, const std::string& path, const std::string& solid_name = "dipper");
 
 }  // namespace dipper::meshes

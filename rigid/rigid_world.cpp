@@ -264,8 +264,8 @@ BodyId RigidWorld::add_kinematic_mesh(const meshes::TriangleMesh& mesh, int mate
     return impl_->insert_mesh(mesh, material, name, true, rotation, translation_m);
 }
 
-BodyId RigidWorld::add_plates(const std::vector<Plate>& plates, int material, const std::string& name, bool kinematic,
-                              const Mat3& rotation, const Vec3& translation_m)
+BodyId RigidWorld::add_plates(const std::vector<meshes::Plate>& plates, int material, const std::string& name,
+                              bool kinematic, const Mat3& rotation, const Vec3& translation_m)
 {
     impl_->check_material(material, concat("part '", name, "'"));
     if (plates.empty()) throw InputError(concat("part '", name, "' has no plates: a body needs a collision shape"));
@@ -275,14 +275,15 @@ BodyId RigidWorld::add_plates(const std::vector<Plate>& plates, int material, co
     b->kinematic = kinematic;
     auto compound = std::make_unique<btCompoundShape>();
     for (std::size_t k = 0; k < plates.size(); ++k) {
-        const Plate& p = plates[k];
-        const Vec3& h = p.half_extents_m;
-        if (!(h.x > 0.0 && h.y > 0.0 && h.z > 0.0) || !is_finite(h) || !is_finite(p.centre_m))
-            throw InputError(concat("part '", name, "', plate ", k, ": half extents (", h.x, ", ", h.y, ", ", h.z,
-                                    ") m; expected finite and > 0"));
-        auto box = std::make_unique<btBoxShape>(to_bt(h));  // the margin lies inside a box: its size is exact
-        compound->addChildShape(btTransform(to_bt(p.rotation), to_bt(p.centre_m)), box.get());
-        b->children.push_back(std::move(box));
+        const ConvexPolyhedron solid = ConvexPolyhedron::hull_of(plates[k].solid_corners_m(), concat("part '", name, "', plate ", k));
+        const double margin = std::min(impl_->settings.rock_margin_m, 0.25 * plates[k].thickness_m);
+        auto hull = std::make_unique<btConvexHullShape>();
+        const ConvexPolyhedron core = solid.shrunk(margin);
+        for (const Vec3& v : core.vertices_m()) hull->addPoint(to_bt(v), false);
+        hull->recalcLocalAabb();
+        hull->setMargin(margin);
+        compound->addChildShape(btTransform::getIdentity(), hull.get());
+        b->children.push_back(std::move(hull));
     }
     b->shape = std::move(compound);
     return impl_->insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform(to_bt(rotation), to_bt(translation_m)));
@@ -387,6 +388,12 @@ void RigidWorld::step()
 }
 
 double RigidWorld::time_s() const { return impl_->time_s; }
+
+void RigidWorld::set_step_s(double step_s)
+{
+    require_positive(step_s, "step_s", "rigid world");
+    impl_->settings.step_s = step_s;
+}
 const RigidSettings& RigidWorld::settings() const { return impl_->settings; }
 
 Vec3 RigidWorld::contact_force_N(BodyId id) const

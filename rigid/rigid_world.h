@@ -4,6 +4,7 @@
 
 #include "core/contact_record.h"
 #include "core/vec3.h"
+#include "meshes/machine_geometry.h"
 #include "meshes/triangle_mesh.h"
 #include "rigid/convex_polyhedron.h"
 
@@ -28,13 +29,6 @@ struct RigidSettings {
     /// faces; only its sharpest corners are rounded (tests: volume within 1 %, extents within 2 %).
     double rock_margin_m = 0.02;
     double rock_margin_fraction = 0.05;
-};
-
-/// A flat plate with thickness, in a part's frame: the convex solids Bullet uses for machine parts.
-struct Plate {
-    Vec3 centre_m;
-    Vec3 half_extents_m;
-    Mat3 rotation;  ///< plate frame to part frame
 };
 
 /// Position, orientation and velocities of a body's centre of mass, world frame.
@@ -69,8 +63,9 @@ public:
     /// gives its pose at the end of that step; Bullet sees the finite-difference velocity.
     BodyId add_kinematic_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
                               const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
-    /// A part made of plates (boxes), fixed or moved from outside like a kinematic mesh.
-    BodyId add_plates(const std::vector<Plate>& plates, int material, const std::string& name, bool kinematic,
+    /// A part made of plates (meshes/machine_geometry.h), fixed or moved from outside like a kinematic
+    /// mesh. Each plate is a convex solid; its collision margin lies inside it, so its faces are exact.
+    BodyId add_plates(const std::vector<meshes::Plate>& plates, int material, const std::string& name, bool kinematic,
                       const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
     void set_kinematic_pose(BodyId body, const Mat3& rotation, const Vec3& translation_m);
     /// A rock: `shape` in its principal frame (ConvexPolyhedron::in_principal_frame, or generate_rock), placed
@@ -94,6 +89,8 @@ public:
     void step();
     double time_s() const;
     const RigidSettings& settings() const;
+    /// Changes the step for the steps that follow (for example: settle a pile at a coarse step).
+    void set_step_s(double step_s);
 
     // ---- contacts of the last step
     /// Sum of contact forces (impulses / step) on a body during the last step, N.

@@ -37,12 +37,12 @@ RockWearRun slide_rocks(double step_s, int iterations, bool slabs)
     w.set_pair("rock", "rock", 0.85, 0.0);
     w.set_pair("rock", "bucket", mu, 0.0);
     const meshes::TriangleMesh surface = meshes::make_open_box_mesh(size, size, height, 0.075);
-    const std::vector<Plate> plates{
-        {{size / 2, size / 2, -thick / 2}, {size / 2 + thick, size / 2 + thick, thick / 2}, Mat3::identity()},
-        {{size / 2, -thick / 2, height / 2}, {size / 2 + thick, thick / 2, height / 2}, Mat3::identity()},
-        {{size / 2, size + thick / 2, height / 2}, {size / 2 + thick, thick / 2, height / 2}, Mat3::identity()},
-        {{-thick / 2, size / 2, height / 2}, {thick / 2, size / 2, height / 2}, Mat3::identity()},
-        {{size + thick / 2, size / 2, height / 2}, {thick / 2, size / 2, height / 2}, Mat3::identity()}};
+    const std::vector<meshes::Plate> plates{
+        meshes::box_plate({-thick, -thick, -thick}, {size + thick, size + thick, 0.0}),
+        meshes::box_plate({-thick, -thick, 0.0}, {size + thick, 0.0, height}),
+        meshes::box_plate({-thick, size, 0.0}, {size + thick, size + thick, height}),
+        meshes::box_plate({-thick, 0.0, 0.0}, {0.0, size, height}),
+        meshes::box_plate({size, 0.0, 0.0}, {size + thick, size, height})};
     const BodyId bucket = w.add_plates(plates, w.material_index("bucket"), "bucket", true);
     std::vector<BodyId> rocks;
     for (int i = 0; i < 3; ++i)
