@@ -1,44 +1,13 @@
 #include "rigid/rigid_world.h"
 
-#include "core/errors.h"
-#include "meshes/triangle_locator.h"
-
-#include <btBulletDynamicsCommon.h>
-#include <BulletCollision/CollisionDispatch/btInternalEdgeUtility.h>
+#include "rigid/detail/world_impl.h"
 
 #include <algorithm>
 #include <cmath>
 
-static_assert(sizeof(btScalar) == sizeof(double), "dipper links Bullet's double-precision build (BT_USE_DOUBLE_PRECISION)");
-
 namespace dipper::rigid {
 
 namespace {
-
-btVector3 to_bt(const Vec3& v) { return {v.x, v.y, v.z}; }
-Vec3 from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
-
-btMatrix3x3 to_bt(const Mat3& m)
-{
-    return {m.m[0][0], m.m[0][1], m.m[0][2], m.m[1][0], m.m[1][1], m.m[1][2], m.m[2][0], m.m[2][1], m.m[2][2]};
-}
-
-Mat3 from_bt(const btMatrix3x3& b)
-{
-    Mat3 m;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) m.m[i][j] = b[i][j];
-    return m;
-}
-
-/// Friction and restitution per material pair; Bullet's contact callback reads it through the bodies'
-/// user pointer.
-struct MaterialPairs {
-    std::vector<std::string> names;
-    std::vector<double> friction, restitution;  // names x names
-    std::vector<bool> set;
-    std::size_t index(int a, int b) const { return static_cast<std::size_t>(a) * names.size() + static_cast<std::size_t>(b); }
-};
 
 // Bullet calls this for every new contact point of a body with CF_CUSTOM_MATERIAL_CALLBACK: the pair's own
 // friction and restitution replace Bullet's product rule, and contacts on triangle meshes get the face
@@ -61,119 +30,6 @@ bool pair_material_callback(btManifoldPoint& cp, const btCollisionObjectWrapper*
 }
 
 }  // namespace
-
-struct RigidWorld::Impl {
-    struct Body {
-        std::string name;
-        int material = 0;
-        bool kinematic = false;
-        double margin_m = 0.0;
-        std::vector<int> indices;
-        std::vector<btScalar> vertices;
-        std::unique_ptr<btTriangleIndexVertexArray> mesh_data;
-        std::unique_ptr<btTriangleInfoMap> edge_info;
-        std::unique_ptr<btCollisionShape> shape;
-        std::vector<std::unique_ptr<btCollisionShape>> children;  // of a compound shape
-        std::unique_ptr<meshes::TriangleLocator> locator;          // of the last wear mesh asked for
-        const meshes::TriangleMesh* located_mesh = nullptr;
-        std::unique_ptr<btDefaultMotionState> motion;
-        std::unique_ptr<btRigidBody> body;
-    };
-
-    explicit Impl(const RigidSettings& s) : settings(s)
-    {
-        world.setGravity(to_bt(s.gravity_m_per_s2));
-        btContactSolverInfo& info = world.getSolverInfo();
-        info.m_numIterations = s.solver_iterations;
-        info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
-        info.m_splitImpulse = 1;
-        info.m_splitImpulsePenetrationThreshold = -s.split_impulse_threshold_m;
-    }
-    ~Impl()
-    {
-        for (auto& b : bodies) world.removeRigidBody(b->body.get());
-    }
-
-    RigidSettings settings;
-    btDefaultCollisionConfiguration config;
-    btCollisionDispatcher dispatcher{&config};
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
-    std::vector<std::unique_ptr<Body>> bodies;
-    MaterialPairs pairs;
-    std::size_t checked_bodies = 0;  // bodies whose material pairs have been checked
-    double time_s = 0.0;
-    std::vector<Vec3> contact_force;
-
-    Body& body(BodyId id, const char* what)
-    {
-        if (id < 0 || static_cast<std::size_t>(id) >= bodies.size())
-            throw InputError(concat(what, ": no body ", id, "; the world has bodies 0..", static_cast<int>(bodies.size()) - 1));
-        return *bodies[static_cast<std::size_t>(id)];
-    }
-    void check_material(int m, const std::string& where) const
-    {
-        if (m < 0 || static_cast<std::size_t>(m) >= pairs.names.size())
-            throw InputError(concat(where, ": material index ", m, " is not defined; the world has ", pairs.names.size(), " materials"));
-    }
-    /// Every pair a rock can meet must have coefficients: checked before the first step with new bodies.
-    void check_pairs()
-    {
-        for (std::size_t i = 0; i < bodies.size(); ++i) {
-            if (bodies[i]->body->getInvMass() == 0.0) continue;
-            for (std::size_t j = 0; j < bodies.size(); ++j) {
-                if (j == i || (j < checked_bodies && i < checked_bodies)) continue;
-                const int a = bodies[i]->material, b = bodies[j]->material;
-                if (!pairs.set[pairs.index(a, b)])
-                    throw InputError(concat("rigid bodies '", bodies[i]->name, "' and '", bodies[j]->name,
-                                            "': no friction and restitution for the material pair ", pairs.names[static_cast<std::size_t>(a)],
-                                            "-", pairs.names[static_cast<std::size_t>(b)], "; set it with set_pair"));
-            }
-        }
-        checked_bodies = bodies.size();
-    }
-
-    BodyId insert(std::unique_ptr<Body> b, double mass, const btVector3& inertia, const btTransform& pose)
-    {
-        b->motion = std::make_unique<btDefaultMotionState>(pose);
-        btRigidBody::btRigidBodyConstructionInfo info(mass, b->motion.get(), b->shape.get(), inertia);
-        info.m_friction = 0.5;  // replaced per pair in the contact callback
-        b->body = std::make_unique<btRigidBody>(info);
-        b->body->setActivationState(DISABLE_DEACTIVATION);  // a resting rock must still feel new loads
-        b->body->setCollisionFlags(b->body->getCollisionFlags() | btCollisionObject::CF_CUSTOM_MATERIAL_CALLBACK |
-                                   (b->kinematic ? btCollisionObject::CF_KINEMATIC_OBJECT : 0));
-        b->body->setUserPointer(&pairs);
-        b->body->setUserIndex(b->material);
-        const BodyId id = static_cast<BodyId>(bodies.size());
-        b->body->setUserIndex2(id);
-        world.addRigidBody(b->body.get());
-        bodies.push_back(std::move(b));
-        contact_force.resize(bodies.size());
-        return id;
-    }
-
-    BodyId insert_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name, bool kinematic,
-                       const Mat3& rotation, const Vec3& translation)
-    {
-        check_material(material, concat("mesh '", name, "'"));
-        if (mesh.triangle_count() == 0) throw InputError(concat("mesh '", name, "' has no triangles"));
-        auto b = std::make_unique<Body>();
-        b->name = name;
-        b->material = material;
-        b->kinematic = kinematic;
-        for (const auto& t : mesh.triangles()) b->indices.insert(b->indices.end(), {int(t[0]), int(t[1]), int(t[2])});
-        for (const Vec3& v : mesh.vertices_m()) b->vertices.insert(b->vertices.end(), {v.x, v.y, v.z});
-        b->mesh_data = std::make_unique<btTriangleIndexVertexArray>(
-            static_cast<int>(mesh.triangle_count()), b->indices.data(), static_cast<int>(3 * sizeof(int)),
-            static_cast<int>(mesh.vertex_count()), b->vertices.data(), static_cast<int>(3 * sizeof(btScalar)));
-        auto shape = std::make_unique<btBvhTriangleMeshShape>(b->mesh_data.get(), true);
-        b->edge_info = std::make_unique<btTriangleInfoMap>();
-        btGenerateInternalEdgeInfo(shape.get(), b->edge_info.get());
-        b->shape = std::move(shape);
-        return insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform(to_bt(rotation), to_bt(translation)));
-    }
-};
 
 RigidWorld::RigidWorld(RigidSettings settings)
 {
@@ -264,6 +120,23 @@ BodyId RigidWorld::add_kinematic_mesh(const meshes::TriangleMesh& mesh, int mate
     return impl_->insert_mesh(mesh, material, name, true, rotation, translation_m);
 }
 
+void add_plate_hulls(btCompoundShape& compound, std::vector<std::unique_ptr<btCollisionShape>>& children,
+                     const std::vector<meshes::Plate>& plates, const btTransform& transform, double max_margin_m,
+                     const std::string& name)
+{
+    for (std::size_t k = 0; k < plates.size(); ++k) {
+        const ConvexPolyhedron solid = ConvexPolyhedron::hull_of(plates[k].solid_corners_m(), concat("part '", name, "', plate ", k));
+        const double margin = std::min(max_margin_m, 0.25 * plates[k].thickness_m);
+        auto hull = std::make_unique<btConvexHullShape>();
+        const ConvexPolyhedron core = solid.shrunk(margin);
+        for (const Vec3& v : core.vertices_m()) hull->addPoint(to_bt(v), false);
+        hull->recalcLocalAabb();
+        hull->setMargin(margin);
+        compound.addChildShape(transform, hull.get());
+        children.push_back(std::move(hull));
+    }
+}
+
 BodyId RigidWorld::add_plates(const std::vector<meshes::Plate>& plates, int material, const std::string& name,
                               bool kinematic, const Mat3& rotation, const Vec3& translation_m)
 {
@@ -274,17 +147,7 @@ BodyId RigidWorld::add_plates(const std::vector<meshes::Plate>& plates, int mate
     b->material = material;
     b->kinematic = kinematic;
     auto compound = std::make_unique<btCompoundShape>();
-    for (std::size_t k = 0; k < plates.size(); ++k) {
-        const ConvexPolyhedron solid = ConvexPolyhedron::hull_of(plates[k].solid_corners_m(), concat("part '", name, "', plate ", k));
-        const double margin = std::min(impl_->settings.rock_margin_m, 0.25 * plates[k].thickness_m);
-        auto hull = std::make_unique<btConvexHullShape>();
-        const ConvexPolyhedron core = solid.shrunk(margin);
-        for (const Vec3& v : core.vertices_m()) hull->addPoint(to_bt(v), false);
-        hull->recalcLocalAabb();
-        hull->setMargin(margin);
-        compound->addChildShape(btTransform::getIdentity(), hull.get());
-        b->children.push_back(std::move(hull));
-    }
+    add_plate_hulls(*compound, b->children, plates, btTransform::getIdentity(), impl_->settings.rock_margin_m, name);
     b->shape = std::move(compound);
     return impl_->insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform(to_bt(rotation), to_bt(translation_m)));
 }
@@ -337,15 +200,26 @@ const std::string& RigidWorld::body_name(BodyId id) const { return impl_->body(i
 
 double RigidWorld::mass_kg(BodyId id) const
 {
-    const btRigidBody* b = impl_->body(id, "mass_kg").body.get();
-    return b->getInvMass() > 0.0 ? 1.0 / b->getInvMass() : 0.0;
+    const Impl::Body& b = impl_->body(id, "mass_kg");
+    if (b.multibody) return b.link < 0 ? b.multibody->getBaseMass() : b.multibody->getLinkMass(b.link);
+    return b.body->getInvMass() > 0.0 ? 1.0 / b.body->getInvMass() : 0.0;
 }
 
 double RigidWorld::margin_m(BodyId id) const { return impl_->body(id, "margin_m").margin_m; }
 
 BodyState RigidWorld::state(BodyId id) const
 {
-    const btRigidBody* b = impl_->body(id, "state").body.get();
+    const Impl::Body& body = impl_->body(id, "state");
+    if (body.multibody) {  // a link: pose from its collider, velocity by finite difference over the last step
+        const btTransform& t = body.link_collider->getWorldTransform();
+        const double dt = impl_->settings.step_s;
+        const btVector3 v = (t.getOrigin() - body.previous_pose.getOrigin()) / dt;
+        btVector3 axis;
+        btScalar angle;
+        btTransformUtil::calculateDiffAxisAngle(body.previous_pose, t, axis, angle);
+        return {from_bt(t.getOrigin()), from_bt(t.getBasis()), from_bt(v), from_bt(axis * (angle / dt))};
+    }
+    const btRigidBody* b = body.body.get();
     const btTransform& t = b->getWorldTransform();
     return {from_bt(t.getOrigin()), from_bt(t.getBasis()), from_bt(b->getLinearVelocity()), from_bt(b->getAngularVelocity())};
 }
@@ -355,6 +229,17 @@ void RigidWorld::apply_force(BodyId id, const Vec3& force, const Vec3& point)
     Impl::Body& b = impl_->body(id, "apply_force");
     if (!is_finite(force) || !is_finite(point))
         throw SimulationError(concat("apply_force on '", b.name, "': force or point is not finite at t = ", impl_->time_s, " s"));
+    if (b.multibody) {
+        const btVector3 f = to_bt(force), arm = to_bt(point) - b.link_collider->getWorldTransform().getOrigin();
+        if (b.link < 0) {
+            b.multibody->addBaseForce(f);
+            b.multibody->addBaseTorque(arm.cross(f));
+        } else {
+            b.multibody->addLinkForce(b.link, f);
+            b.multibody->addLinkTorque(b.link, arm.cross(f));
+        }
+        return;
+    }
     if (b.body->getInvMass() == 0.0) return;  // static and kinematic bodies do not respond to forces
     b.body->applyForce(to_bt(force), to_bt(point) - b.body->getCenterOfMassPosition());
 }
@@ -363,8 +248,12 @@ void RigidWorld::step()
 {
     const double dt = impl_->settings.step_s;
     if (impl_->checked_bodies != impl_->bodies.size()) impl_->check_pairs();
+    for (auto& b : impl_->bodies)
+        if (b->multibody) b->previous_pose = b->link_collider->getWorldTransform();
+    if (impl_->shovel) shovel_before_step(*impl_, impl_->time_s + dt);
     impl_->world.stepSimulation(dt, 0);  // maxSubSteps = 0: exactly one step of dt, no interpolation
     impl_->time_s += dt;
+    if (impl_->shovel) shovel_after_step(*impl_);
 
     std::fill(impl_->contact_force.begin(), impl_->contact_force.end(), Vec3{});
     btDispatcher& d = impl_->dispatcher;
@@ -380,8 +269,9 @@ void RigidWorld::step()
         }
     }
     for (const auto& b : impl_->bodies) {
-        const btRigidBody* body = b->body.get();
-        if (!is_finite(from_bt(body->getCenterOfMassPosition())) || !is_finite(from_bt(body->getLinearVelocity())))
+        const btVector3 x = b->object()->getWorldTransform().getOrigin();
+        const btVector3 v = b->body ? b->body->getLinearVelocity() : btVector3(0, 0, 0);
+        if (!is_finite(from_bt(x)) || !is_finite(from_bt(v)))
             throw SimulationError(concat("rigid body '", b->name, "' has a non-finite position or velocity at t = ",
                                          impl_->time_s, " s; try a smaller step than ", dt, " s"));
     }
@@ -424,8 +314,8 @@ double RigidWorld::kinetic_energy_J() const
 {
     double e = 0.0;
     for (const auto& b : impl_->bodies) {
+        if (!b->is_rock()) continue;
         const btRigidBody* body = b->body.get();
-        if (body->getInvMass() == 0.0) continue;
         const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
         const btVector3 local_w = body->getWorldTransform().getBasis().transpose() * w;
         const btVector3 inv = body->getInvInertiaDiagLocal();
@@ -444,7 +334,7 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
         part.locator = std::make_unique<meshes::TriangleLocator>(*wear_mesh);
         part.located_mesh = wear_mesh;
     }
-    const btTransform to_part = part.body->getWorldTransform().inverse();
+    const btTransform to_part = (part.object()->getWorldTransform() * part.part_in_object).inverse();
     const double dt = impl_->settings.step_s;
     std::vector<ContactRecord> out;
     btDispatcher& d = impl_->dispatcher;
@@ -454,7 +344,6 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
         const bool surface_is_b = m->getBody1()->getUserIndex2() == surface;
         if (!surface_is_a && !surface_is_b) continue;
         const auto* other = btRigidBody::upcast(surface_is_a ? m->getBody1() : m->getBody0());
-        const auto* self = btRigidBody::upcast(surface_is_a ? m->getBody0() : m->getBody1());
         if (!other || other->getInvMass() == 0.0) continue;  // rocks only
         for (int k = 0; k < m->getNumContacts(); ++k) {
             const btManifoldPoint& p = m->getContactPoint(k);
@@ -469,12 +358,12 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
             r.tangential_force_N = friction_on_a * sign;
             const btVector3 at = surface_is_b ? p.getPositionWorldOnA() : p.getPositionWorldOnB();
             const btVector3 v_other = other->getVelocityInLocalPoint(at - other->getCenterOfMassPosition());
-            const btVector3 v_self = self->getVelocityInLocalPoint(to_bt(r.point_world) - self->getCenterOfMassPosition());
+            const btVector3 v_self = part.velocity_at(to_bt(r.point_world), dt);
             r.relative_displacement_m = from_bt(v_other - v_self) * dt;
             r.overlap_m = std::max(0.0, -p.getDistance());
             r.surface_id = surface_id;
             r.triangle_id = surface_is_b ? p.m_index1 : p.m_index0;
-            if (part.body->getCollisionShape()->getShapeType() != TRIANGLE_MESH_SHAPE_PROXYTYPE) r.triangle_id = -1;
+            if (part.object()->getCollisionShape()->getShapeType() != TRIANGLE_MESH_SHAPE_PROXYTYPE) r.triangle_id = -1;
             if (wear_mesh) r.triangle_id = part.locator->nearest(from_bt(to_part * to_bt(r.point_world))).triangle;
             r.particle_index = other->getUserIndex2();
             r.particle_mass_kg = 1.0 / other->getInvMass();

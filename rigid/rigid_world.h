@@ -7,6 +7,7 @@
 #include "meshes/machine_geometry.h"
 #include "meshes/triangle_mesh.h"
 #include "rigid/convex_polyhedron.h"
+#include "rigid/rope_shovel.h"
 
 #include <memory>
 #include <string>
@@ -84,6 +85,24 @@ public:
     /// Adds a force acting at a world point during the next step only (Bullet clears forces each step).
     void apply_force(BodyId body, const Vec3& force_N, const Vec3& point_world_m);
 
+    // ---- the rope shovel (one per world)
+    struct ShovelParts {
+        BodyId dipper = -1, door = -1;
+    };
+    /// Builds the shovel as a Bullet multibody: crawlers fixed; upper body on a swing hinge (motor);
+    /// boom part of the upper body; saddle block on a free hinge at the shipper shaft; dipper handle
+    /// prismatic in the saddle block (motor) with the dipper fixed on it; door hinged at the dipper's
+    /// rear (motor); two hoist ropes from the boom-point sheave to the bail pins, tension only. The motors
+    /// follow `motion`; the ropes pay out its hoist length. The machine frame is placed at `position_m`
+    /// turned by `heading_deg` about z. The dipper and door collide with rocks through their plates.
+    ShovelParts add_rope_shovel(const meshes::Dipper& dipper, const ShovelGeometry& geometry, MotionCurves motion,
+                                int dipper_material, const Vec3& position_m = {}, double heading_deg = 0.0);
+    /// The shovel's forces and pose after the last step.
+    const ShovelReading& shovel_reading() const;
+    /// The dipper frame and the door frame (rotation, origin) in the world, for surfaces that follow them.
+    void dipper_pose(Mat3& rotation, Vec3& origin_m) const;
+    void door_pose(Mat3& rotation, Vec3& origin_m) const;
+
     // ---- stepping
     /// Exactly one Bullet step of settings().step_s: no sub-steps, no interpolation.
     void step();
@@ -109,8 +128,9 @@ public:
     /// Kinetic energy of the dynamic bodies (rocks), J.
     double kinetic_energy_J() const;
 
+    struct Impl;  ///< Bullet's side, opaque outside rigid/
+
 private:
-    struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 

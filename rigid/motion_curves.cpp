@@ -1,0 +1,134 @@
+#include "rigid/motion_curves.h"
+
+#include "core/errors.h"
+#include "core/files.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace dipper::rigid {
+
+namespace {
+
+std::string trim(const std::string& s)
+{
+    const auto a = s.find_first_not_of(" \t\r");
+    if (a == std::string::npos) return {};
+    return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
+}
+
+const std::vector<std::string>& columns()
+{
+    static const std::vector<std::string> c{"time_s", "hoist_length_m", "crowd_extension_m", "swing_deg", "door_deg"};
+    return c;
+}
+
+}  // namespace
+
+MotionCurves MotionCurves::from_samples(std::vector<MotionSample> samples, const std::string& source)
+{
+    if (samples.size() < 2) throw InputError(concat(source, ": motion needs at least 2 samples; got ", samples.size()));
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+        const MotionSample& s = samples[k];
+        const std::string where = concat(source, ", sample ", k);
+        for (const double v : {s.time_s, s.hoist_length_m, s.crowd_extension_m, s.swing_deg, s.door_deg})
+            if (!std::isfinite(v)) throw InputError(concat(where, ": a value is not finite"));
+        if (k > 0 && !(s.time_s > samples[k - 1].time_s))
+            throw InputError(concat(where, ": time_s ", s.time_s, " does not follow ", samples[k - 1].time_s,
+                                    "; times must increase"));
+        require_positive(s.hoist_length_m, "hoist_length_m", where);
+        require_positive(s.crowd_extension_m, "crowd_extension_m", where);
+    }
+    MotionCurves m;
+    m.samples_ = std::move(samples);
+    m.source_ = source;
+    return m;
+}
+
+MotionCurves MotionCurves::from_csv(const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in) throw InputError(concat("cannot open motion file '", path, "'"));
+    std::string line;
+    int number = 0;
+    std::map<std::string, std::size_t> column;
+    std::vector<MotionSample> samples;
+    double last_time = -1e300;
+    while (std::getline(in, line)) {
+        ++number;
+        const std::string text = trim(line);
+        if (text.empty() || text[0] == '#') continue;
+        std::vector<std::string> cells;
+        std::stringstream ss(text);
+        std::string cell;
+        while (std::getline(ss, cell, ',')) cells.push_back(trim(cell));
+        const std::string where = concat(path, ":", number);
+        if (column.empty()) {
+            for (std::size_t c = 0; c < cells.size(); ++c) {
+                if (std::find(columns().begin(), columns().end(), cells[c]) == columns().end())
+                    throw InputError(concat(where, ": unknown column '", cells[c],
+                                            "'; expected time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg"));
+                column[cells[c]] = c;
+            }
+            for (const auto& name : columns())
+                if (!column.count(name))
+                    throw InputError(concat(where, ": the header lacks column '", name,
+                                            "'; expected time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg"));
+            continue;
+        }
+        if (cells.size() != column.size())
+            throw InputError(concat(where, ": ", cells.size(), " values; the header has ", column.size(), " columns"));
+        const auto value = [&](const std::string& name) {
+            const std::string& t = cells[column[name]];
+            std::size_t used = 0;
+            double v = std::nan("");
+            try {
+                v = std::stod(t, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used == 0 || used != t.size() || !std::isfinite(v))
+                throw InputError(concat(where, ": column '", name, "' has '", t, "'; expected a finite number"));
+            return v;
+        };
+        MotionSample s{value("time_s"), value("hoist_length_m"), value("crowd_extension_m"), value("swing_deg"), value("door_deg")};
+        if (!(s.time_s > last_time))
+            throw InputError(concat(where, ": time_s ", s.time_s, " is not after the previous time ", last_time,
+                                    "; times must increase"));
+        if (!(s.hoist_length_m > 0.0)) throw InputError(concat(where, ": hoist_length_m is ", s.hoist_length_m, "; expected > 0"));
+        if (!(s.crowd_extension_m > 0.0))
+            throw InputError(concat(where, ": crowd_extension_m is ", s.crowd_extension_m, "; expected > 0"));
+        last_time = s.time_s;
+        samples.push_back(s);
+    }
+    if (column.empty()) throw InputError(concat("motion file '", path, "' is empty; expected a header and samples"));
+    return from_samples(std::move(samples), path);
+}
+
+MotionSample MotionCurves::at(double t) const
+{
+    if (t <= samples_.front().time_s) return samples_.front();
+    if (t >= samples_.back().time_s) return samples_.back();
+    const auto it = std::upper_bound(samples_.begin(), samples_.end(), t,
+                                     [](double time, const MotionSample& s) { return time < s.time_s; });
+    const MotionSample& b = *it;
+    const MotionSample& a = *(it - 1);
+    const double u = (t - a.time_s) / (b.time_s - a.time_s);
+    const auto mix = [u](double x, double y) { return x + (y - x) * u; };
+    return {t, mix(a.hoist_length_m, b.hoist_length_m), mix(a.crowd_extension_m, b.crowd_extension_m),
+            mix(a.swing_deg, b.swing_deg), mix(a.door_deg, b.door_deg)};
+}
+
+void MotionCurves::write_csv(const std::string& path) const
+{
+    std::ofstream out = open_for_writing(path);
+    out << "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg\n";
+    for (const MotionSample& s : samples_)
+        out << s.time_s << ',' << s.hoist_length_m << ',' << s.crowd_extension_m << ',' << s.swing_deg << ',' << s.door_deg << '\n';
+    finish_writing(out, path);
+}
+
+}  // namespace dipper::rigid

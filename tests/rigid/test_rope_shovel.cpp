@@ -1,0 +1,251 @@
+// The rope shovel: statics against a hand calculation, the rake angle of the posed model, slack ropes,
+// tracking of the prescribed curves while digging through rocks, the default cycle, and bad motion files.
+#include "core/errors.h"
+#include "meshes/machine_geometry.h"
+#include "rigid/rigid_world.h"
+#include "rigid/rock_generator.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+using namespace dipper;
+using namespace dipper::rigid;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+RigidWorld shovel_world(double step_s = 1e-3)
+{
+    RigidSettings s;
+    s.step_s = step_s;
+    RigidWorld w(s);
+    w.add_material("rock");
+    w.add_material("steel");
+    w.add_material("ground");
+    w.set_pair("rock", "rock", 0.85, 0.0);
+    w.set_pair("rock", "steel", 0.53, 0.0);
+    w.set_pair("rock", "ground", 0.9, 0.0);
+    w.set_pair("steel", "ground", 0.5, 0.0);
+    return w;
+}
+
+MotionCurves hold(double hoist, double crowd, double swing = 0.0, double door = 0.0)
+{
+    return MotionCurves::from_samples({{0.0, hoist, crowd, swing, door}, {1000.0, hoist, crowd, swing, door}}, "hold");
+}
+
+/// Centroid of the steel of some plates: each a prism of face area x thickness.
+Vec3 plates_centroid(const std::vector<meshes::Plate>& plates)
+{
+    double volume = 0.0;
+    Vec3 moment;
+    for (const auto& p : plates) {
+        const auto& c = p.corners_m;
+        const double a1 = 0.5 * norm(cross(c[1] - c[0], c[2] - c[0])), a2 = 0.5 * norm(cross(c[2] - c[0], c[3] - c[0]));
+        const Vec3 face = ((c[0] + c[1] + c[2]) * (a1 / 3.0) + (c[0] + c[2] + c[3]) * (a2 / 3.0)) * (1.0 / (a1 + a2));
+        const double v = (a1 + a2) * p.thickness_m;
+        volume += v;
+        moment += (face - p.normal() * (p.thickness_m / 2.0)) * v;
+    }
+    return moment * (1.0 / volume);
+}
+
+std::string temp_file(const std::string& name, const std::string& text)
+{
+    const auto path = std::filesystem::temp_directory_path() / ("dipper_test_" + name);
+    std::ofstream(path) << text;
+    return path.string();
+}
+
+}  // namespace
+
+TEST_CASE("the dipper at rest with an 80 t payload: hoist and crowd forces equal the hand statics (2 %)",
+          "[rigid][shovel][statics][unit]")
+{
+    // Hand statics in the boom plane. The handle, dipper, door and payload turn together about the
+    // shipper shaft S (the saddle hinge is free); the ropes pull the bail towards the sheave P.
+    //   moments about S:   T (r_B x e)_y + sum m_i g (x_i - S_x) = 0     (gravity's moment is m g (x - S_x))
+    //   along the handle:  F_crowd = -(W + T e) . u
+    // with e the rope direction, u the handle axis. Positions come from the pure geometry (pose_shovel) at
+    // the handle angle the model settled to, masses from the geometry parameters. Measured: at 0.14 deg
+    // hoist 1.49727 MN and crowd 381.171 kN, both within 1e-5 of the hand values; at 30.2 deg hoist
+    // +1.4e-5, crowd +1.6e-4.
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    for (const double angle_guess : {0.0, 30.0}) {
+        ShovelGeometry g;
+        g.payload_kg = 80000.0;
+        const double crowd = 7.0;
+        const double hoist = pose_shovel(g, dipper, angle_guess, crowd).rope_length_m;
+        RigidWorld w = shovel_world();
+        w.add_rope_shovel(dipper, g, hold(hoist, crowd), w.material_index("steel"));
+        for (int k = 0; k < 4000; ++k) w.step();  // rope oscillation damped out (ratio 0.2, 3 Hz)
+        const ShovelReading r = w.shovel_reading();
+        CAPTURE(angle_guess, r.handle_angle_deg);
+
+        const ShovelPose p = pose_shovel(g, dipper, r.handle_angle_deg, r.crowd_extension_m);
+        const Vec3 S = p.shipper_shaft_m;
+        const Mat3& R = p.dipper_rotation;
+        const Vec3 O = p.dipper_origin_m;
+        const auto& dp = dipper.parameters;
+        // struck volume centroid of the trapezoid (0,0), (Lb,0), (Lt,H), (0,H): for 4, 3, 3 m it is
+        // x = (Lb^2 + Lb Lt + Lt^2) / (3 (Lb + Lt)), z = H (Lb + 2 Lt) / (3 (Lb + Lt))
+        const double lb = dp.bottom_length_m, lt = dp.top_length_m, h = dp.height_m;
+        const Vec3 payload_local{(lb * lb + lb * lt + lt * lt) / (3.0 * (lb + lt)), 0.0, h * (lb + 2.0 * lt) / (3.0 * (lb + lt))};
+        struct Mass { double m; Vec3 x; };
+        const Mass masses[] = {
+            {g.handle_mass_kg, S + p.handle_axis * (r.crowd_extension_m - g.handle_length_m / 2.0)},
+            {g.dipper_mass_kg, O + R * plates_centroid(dipper.body.plates)},
+            {g.door_mass_kg, O + R * (dipper.door_hinge_m + plates_centroid(dipper.door.plates))},
+            {g.payload_kg, O + R * payload_local},
+        };
+        double gravity_moment = 0.0, total_mass = 0.0;
+        for (const Mass& m : masses) {
+            gravity_moment += m.m * kG * (m.x.x - S.x);
+            total_mass += m.m;
+        }
+        const Vec3 bail = p.bail_m[0], e = normalized(p.sheave_m - bail);
+        const Vec3 rb = bail - S;
+        const double arm = rb.z * e.x - rb.x * e.z;  // y-moment of a unit pull along e at the bail
+        const double hoist_hand = -gravity_moment / arm;  // both ropes together (x, z parts of e are shared)
+        const Vec3 pull{hoist_hand * e.x, 0.0, hoist_hand * e.z};
+        const double crowd_hand = -dot(Vec3{0.0, 0.0, -total_mass * kG} + pull, p.handle_axis);
+
+        CHECK(r.hoist_force_N == Approx(hoist_hand).epsilon(0.02));
+        CHECK(r.crowd_force_N == Approx(crowd_hand).epsilon(0.02));
+        CHECK(r.rope_tension_N[0] == Approx(r.rope_tension_N[1]).epsilon(1e-9));
+    }
+}
+
+TEST_CASE("the rake angle measured on the posed model equals the configured one", "[rigid][shovel][unit]")
+{
+    for (const double rake : {57.8, 61.8, 65.8}) {
+        meshes::DipperParameters dp;
+        dp.rake_angle_deg = rake;
+        dp.element_size_m = 0.3;
+        const meshes::Dipper dipper = meshes::make_dipper(dp);
+        ShovelGeometry g;
+        RigidWorld w = shovel_world();
+        w.add_rope_shovel(dipper, g, default_loading_cycle(g, dipper), w.material_index("steel"));
+        for (int k = 0; k < 20000; ++k) {  // through the dig and the swing: many poses
+            w.step();
+            if (k % 1000 == 0) CHECK(w.shovel_reading().rake_angle_deg == Approx(rake).margin(1e-6));
+        }
+    }
+}
+
+TEST_CASE("a rope never pushes: paid out beyond reach, the dipper rests on the ground and the ropes carry 0",
+          "[rigid][shovel][unit]")
+{
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    ShovelGeometry g;
+    RigidWorld w = shovel_world();
+    w.add_ground_plane(0.0, w.material_index("ground"), "ground");
+    // ropes 3 m longer than needed to hold the dipper at 60 deg: it swings down onto the ground
+    const double hoist = pose_shovel(g, dipper, 60.0, 8.0).rope_length_m + 3.0;
+    w.add_rope_shovel(dipper, g, hold(hoist, 8.0), w.material_index("steel"));
+    int slack_steps = 0;
+    for (int k = 0; k < 4000; ++k) {
+        w.step();
+        const ShovelReading& r = w.shovel_reading();
+        CHECK(r.rope_tension_N[0] >= 0.0);
+        CHECK(r.rope_tension_N[1] >= 0.0);
+        if (r.rope_length_m[0] < hoist) {
+            ++slack_steps;
+            CHECK(r.rope_tension_N[0] == 0.0);
+            CHECK(r.hoist_force_N == 0.0);
+        }
+    }
+    CHECK(slack_steps > 3000);
+    CHECK(w.shovel_reading().rope_length_m[0] < hoist - 0.1);  // resting on the ground, the rope hangs slack
+}
+
+TEST_CASE("the default cycle: three passes in 138 s with 15 s digs; the shovel follows it", "[rigid][shovel][unit]")
+{
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    ShovelGeometry g;
+    const MotionCurves cycle = default_loading_cycle(g, dipper);
+    CHECK(cycle.duration_s() == Approx(137.99));
+    for (int pass = 0; pass < 3; ++pass) {
+        const double t0 = 46.0 * pass;
+        CHECK(cycle.at(t0).hoist_length_m > cycle.at(t0 + 15.0).hoist_length_m + 8.0);  // hoisting in while digging
+        CHECK(cycle.at(t0 + 26.0).door_deg == Approx(60.0));                               // dumping
+        CHECK(cycle.at(t0 + 25.0).swing_deg == Approx(90.0));
+    }
+    // tracking without load: crowd to 1e-6 m (a position motor), swing to 1e-6 deg
+    RigidWorld w = shovel_world();
+    w.add_rope_shovel(dipper, g, cycle, w.material_index("steel"));
+    double crowd_error = 0.0, swing_error = 0.0;
+    for (int k = 0; k < 46000; ++k) {
+        w.step();
+        const ShovelReading& r = w.shovel_reading();
+        const MotionSample m = cycle.at(r.time_s);
+        crowd_error = std::max(crowd_error, std::abs(r.crowd_extension_m - m.crowd_extension_m));
+        swing_error = std::max(swing_error, std::abs(r.swing_deg - m.swing_deg));
+    }
+    CHECK(crowd_error < 1e-6);
+    CHECK(swing_error < 1e-6);
+}
+
+TEST_CASE("the shovel follows its curves while digging through a rock pile", "[rigid][shovel][rocks][unit]")
+{
+    // 60 rocks of 300-600 mm dropped at the toe of the dig; the first 8 s of the dig. The crowd is a position
+    // motor: within 1 mm. The ropes are elastic: the measured length exceeds the paid-out length by the
+    // stretch T / k (k = EA / L), which the test bounds by the largest tension seen plus 2 cm of dynamics.
+    // Measured: crowd within 2.8e-6 m; rope length 4.7 cm over the paid-out length with 3.9 cm of stretch.
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    ShovelGeometry g;
+    const MotionCurves cycle = default_loading_cycle(g, dipper);
+    RigidWorld w = shovel_world();
+    w.add_ground_plane(0.0, w.material_index("ground"), "ground");
+    for (int k = 0; k < 60; ++k) {
+        const int i = k % 6, j = (k / 6) % 5, layer = k / 30;
+        const ConvexPolyhedron r = generate_rock({0.3 + 0.1 * (k % 4), 1.0, 1.8, 18}, 500 + static_cast<std::uint64_t>(k));
+        w.add_rock(r, 2700.0, w.material_index("rock"), {18.0 + 0.75 * i, -1.9 + 0.95 * j, 0.5 + 0.75 * layer});
+    }
+    double crowd_error = 0.0, excess = 0.0, stretch_bound = 0.0, peak_dig = 0.0;
+    int dipper_contacts = 0;
+    const RigidWorld::ShovelParts parts = w.add_rope_shovel(dipper, g, cycle, w.material_index("steel"));
+    for (int k = 0; k < 8000; ++k) {
+        w.step();
+        const ShovelReading& r = w.shovel_reading();
+        const MotionSample m = cycle.at(r.time_s);
+        crowd_error = std::max(crowd_error, std::abs(r.crowd_extension_m - m.crowd_extension_m));
+        const double k_rope = g.rope_axial_stiffness_N / m.hoist_length_m;
+        excess = std::max(excess, r.rope_length_m[0] - m.hoist_length_m);
+        stretch_bound = std::max(stretch_bound, r.rope_tension_N[0] / k_rope);
+        peak_dig = std::max(peak_dig, r.dig_force_filtered_N);
+        dipper_contacts += static_cast<int>(w.surface_contacts(parts.dipper, 0).size());
+    }
+    CHECK(crowd_error < 1e-3);
+    CHECK(excess < stretch_bound + 0.02);
+    CHECK(dipper_contacts > 0);  // it did dig through rocks
+}
+
+TEST_CASE("motion files: unsorted times, missing columns and NaN are errors naming file, line and value",
+          "[rigid][shovel][unit][bad_input]")
+{
+    const std::string header = "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg\n";
+    const auto ok = MotionCurves::from_csv(temp_file("motion_ok.csv", header + "0,15,8,0,0\n10,7,7.5,0,0\n"));
+    CHECK(ok.at(5.0).hoist_length_m == Approx(11.0));
+    CHECK(ok.at(-1.0).crowd_extension_m == 8.0);
+    CHECK(ok.at(99.0).crowd_extension_m == 7.5);
+    CHECK_THROWS_WITH(MotionCurves::from_csv(temp_file("motion_unsorted.csv", header + "0,15,8,0,0\n10,7,7.5,0,0\n5,9,8,0,0\n")),
+                      Catch::Contains("motion_unsorted.csv:4") && Catch::Contains("time_s 5") && Catch::Contains("increase"));
+    CHECK_THROWS_WITH(MotionCurves::from_csv(temp_file("motion_missing.csv", "time_s,hoist_length_m,crowd_extension_m,swing_deg\n0,15,8,0\n")),
+                      Catch::Contains("motion_missing.csv:1") && Catch::Contains("lacks column 'door_deg'"));
+    CHECK_THROWS_WITH(MotionCurves::from_csv(temp_file("motion_nan.csv", header + "0,15,8,0,0\n10,nan,7.5,0,0\n")),
+                      Catch::Contains("motion_nan.csv:3") && Catch::Contains("hoist_length_m") && Catch::Contains("'nan'"));
+    CHECK_THROWS_WITH(MotionCurves::from_csv(temp_file("motion_negative.csv", header + "0,15,8,0,0\n10,-2,7.5,0,0\n")),
+                      Catch::Contains("motion_negative.csv:3") && Catch::Contains("hoist_length_m is -2"));
+    CHECK_THROWS_WITH(MotionCurves::from_csv(temp_file("motion_empty.csv", "")), Catch::Contains("is empty"));
+    CHECK_THROWS_WITH(MotionCurves::from_csv("/nonexistent/motion.csv"), Catch::Contains("cannot open motion file"));
+    // a first hoist length too short to reach the dipper at that crowd
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    RigidWorld w = shovel_world();
+    CHECK_THROWS_WITH(w.add_rope_shovel(dipper, {}, hold(2.0, 8.0), w.material_index("steel")),
+                      Catch::Contains("first hoist length 2 m cannot hold the dipper"));
+}
