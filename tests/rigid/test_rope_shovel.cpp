@@ -218,7 +218,24 @@ TEST_CASE("the shovel follows its curves while digging through a rock pile", "[r
         excess = std::max(excess, r.rope_length_m[0] - m.hoist_length_m);
         stretch_bound = std::max(stretch_bound, r.rope_tension_N[0] / k_rope);
         peak_dig = std::max(peak_dig, r.dig_force_filtered_N);
-        dipper_contacts += static_cast<int>(w.surface_contacts(parts.dipper, 0).size());
+        // contact records on the dipper name the dipper surface triangle under the contact point
+        const std::vector<ContactRecord> records = w.surface_contacts(parts.dipper, 7, &dipper.body.surface);
+        dipper_contacts += static_cast<int>(records.size());
+        if (!records.empty()) {
+            Mat3 rotation;
+            Vec3 origin;
+            w.dipper_pose(rotation, origin);
+            for (const ContactRecord& c : records) {
+                REQUIRE(c.triangle_id >= 0);
+                REQUIRE(static_cast<std::size_t>(c.triangle_id) < dipper.body.surface.triangle_count());
+                CHECK(c.surface_id == 7);
+                CHECK(c.normal_force_N >= 0.0);
+                const Vec3 local = rotation.transposed() * (c.point_world - origin);
+                const auto& t = dipper.body.surface.triangles()[static_cast<std::size_t>(c.triangle_id)];
+                const auto& x = dipper.body.surface.vertices_m();
+                CHECK(std::sqrt(meshes::closest_point_on_triangle(local, x[t[0]], x[t[1]], x[t[2]]).distance_squared) < 0.02);
+            }
+        }
     }
     CHECK(crowd_error < 1e-3);
     CHECK(excess < stretch_bound + 0.02);
