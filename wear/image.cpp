@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 
 namespace dipper::wear {
@@ -73,6 +74,84 @@ void put_chunk(std::ofstream& out, const char* type, const std::vector<std::uint
     for (const std::uint8_t b : data) chunk.push_back(b);
     put_u32(chunk, crc32(chunk.data() + 4, chunk.size() - 4));
     out.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(chunk.size()));
+}
+
+/// Writes bits least significant first, as deflate packs them.
+class BitWriter {
+public:
+    explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out) {}
+    void bits(std::uint32_t value, int count)
+    {
+        for (int k = 0; k < count; ++k) put((value >> k) & 1u);
+    }
+    /// A Huffman code: its bits go most significant first.
+    void code(std::uint32_t value, int count)
+    {
+        for (int k = count - 1; k >= 0; --k) put((value >> k) & 1u);
+    }
+    void flush()
+    {
+        if (used_ > 0) out_.push_back(current_);
+        current_ = 0;
+        used_ = 0;
+    }
+
+private:
+    void put(std::uint32_t bit)
+    {
+        current_ = static_cast<std::uint8_t>(current_ | (bit << used_));
+        if (++used_ == 8) flush();
+    }
+    std::vector<std::uint8_t>& out_;
+    std::uint8_t current_ = 0;
+    int used_ = 0;
+};
+
+void literal_code(BitWriter& w, int symbol)
+{
+    if (symbol <= 143) w.code(static_cast<std::uint32_t>(0x30 + symbol), 8);
+    else if (symbol <= 255) w.code(static_cast<std::uint32_t>(0x190 + symbol - 144), 9);
+    else if (symbol <= 279) w.code(static_cast<std::uint32_t>(symbol - 256), 7);
+    else w.code(static_cast<std::uint32_t>(0xc0 + symbol - 280), 8);
+}
+
+/// One final deflate block with fixed codes; back-references only at the given distances.
+void deflate_fixed(const std::vector<std::uint8_t>& data, std::initializer_list<std::size_t> distances, std::vector<std::uint8_t>& out)
+{
+    static const int length_base[29] = {3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 15, 17, 19, 23, 27, 31, 35, 43, 51, 59, 67, 83, 99, 115, 131, 163, 195, 227, 258};
+    static const int length_extra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
+    static const int distance_base[30] = {1, 2, 3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65, 97, 129, 193, 257, 385, 513, 769,
+                                          1025, 1537, 2049, 3073, 4097, 6145, 8193, 12289, 16385, 24577};
+    static const int distance_extra[30] = {0, 0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9, 9, 10, 10, 11, 11, 12, 12, 13, 13};
+    BitWriter w(out);
+    w.bits(1, 1);  // final block
+    w.bits(1, 2);  // fixed Huffman codes
+    std::size_t i = 0;
+    while (i < data.size()) {
+        std::size_t best_length = 0, best_distance = 0;
+        for (const std::size_t d : distances) {
+            if (d > i || d > 32768) continue;
+            std::size_t n = 0;
+            while (n < 258 && i + n < data.size() && data[i + n] == data[i + n - d]) ++n;
+            if (n > best_length) { best_length = n; best_distance = d; }
+        }
+        if (best_length < 3) {
+            literal_code(w, data[i]);
+            ++i;
+            continue;
+        }
+        int lc = 28;
+        while (length_base[lc] > static_cast<int>(best_length)) --lc;
+        literal_code(w, 257 + lc);
+        w.bits(static_cast<std::uint32_t>(static_cast<int>(best_length) - length_base[lc]), length_extra[lc]);
+        int dc = 29;
+        while (distance_base[dc] > static_cast<int>(best_distance)) --dc;
+        w.code(static_cast<std::uint32_t>(dc), 5);
+        w.bits(static_cast<std::uint32_t>(static_cast<int>(best_distance) - distance_base[dc]), distance_extra[dc]);
+        i += best_length;
+    }
+    literal_code(w, 256);  // end of block
+    w.flush();
 }
 
 }  // namespace
@@ -182,20 +261,10 @@ void Image::write_png(const std::string& path) const
         raw.insert(raw.end(), rgb_.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(yy)),
                    rgb_.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(yy + 1)));
     }
-    // zlib stream of stored (uncompressed) deflate blocks, with its Adler-32
+    // zlib stream: one deflate block with the fixed Huffman codes (RFC 1951 §3.2.6); matches are looked
+    // for one pixel back and one row up, which is where a picture of flat colours repeats itself
     std::vector<std::uint8_t> z{0x78, 0x01};
-    for (std::size_t pos = 0; pos < raw.size() || pos == 0;) {
-        const std::size_t n = std::min<std::size_t>(65535, raw.size() - pos);
-        const bool last = pos + n >= raw.size();
-        z.push_back(last ? 1 : 0);
-        z.push_back(static_cast<std::uint8_t>(n & 0xff));
-        z.push_back(static_cast<std::uint8_t>(n >> 8));
-        z.push_back(static_cast<std::uint8_t>(~n & 0xff));
-        z.push_back(static_cast<std::uint8_t>((~n >> 8) & 0xff));
-        z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos), raw.begin() + static_cast<std::ptrdiff_t>(pos + n));
-        pos += n;
-        if (last) break;
-    }
+    deflate_fixed(raw, {3, row + 1}, z);
     std::uint32_t a = 1, b = 0;
     for (const std::uint8_t v : raw) {
         a = (a + v) % 65521u;

@@ -1,5 +1,5 @@
 // A small RGB raster for wear-map pictures: filled triangles with interpolated colour, rectangles, a
-// built-in 5x7 pixel font for numbers and units, and a PNG writer (uncompressed deflate, no dependency).
+// built-in 5x7 pixel font for numbers and units, and a PNG writer (deflate with fixed codes, no dependency).
 #pragma once
 
 #include <cstdint>

@@ -2,6 +2,7 @@
 // the pile's weight. Rocks of the thesis' size classes (Table 1 mass fractions 300/400/600/850 mm =
 // 10/9/19/25) are dropped from a loose lattice onto the ground and settled; then steps are timed.
 // Usage: dipper_bench_rock_pile [--rocks N] [--dt S] [--settle-s S] [--settle-dt S] [--steps N] [--point-count N]
+//                               [--iterations N] [--margin-fraction F]
 // The pile settles at --settle-dt (default 1e-3 s), then takes 100 steps at --dt before the timed ones.
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"
@@ -23,8 +24,8 @@ using namespace dipper::rigid;
 
 int main(int argc, char** argv)
 {
-    int rocks = 1000, steps = 200, point_count = 20;
-    double dt = 1e-3, settle_s = 2.0, settle_dt = 1e-3;
+    int rocks = 1000, steps = 200, point_count = 20, iterations = 10;
+    double dt = 1e-3, settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
     for (int k = 1; k + 1 < argc; k += 2) {
         const std::string key = argv[k];
         if (key == "--rocks") rocks = std::atoi(argv[k + 1]);
@@ -33,6 +34,8 @@ int main(int argc, char** argv)
         else if (key == "--settle-dt") settle_dt = std::atof(argv[k + 1]);
         else if (key == "--steps") steps = std::atoi(argv[k + 1]);
         else if (key == "--point-count") point_count = std::atoi(argv[k + 1]);
+        else if (key == "--iterations") iterations = std::atoi(argv[k + 1]);
+        else if (key == "--margin-fraction") margin_fraction = std::atof(argv[k + 1]);
         else {
             std::fprintf(stderr, "unknown option %s\n", argv[k]);
             return 2;
@@ -40,6 +43,8 @@ int main(int argc, char** argv)
     }
     RigidSettings settings;
     settings.step_s = settle_dt;
+    settings.solver_iterations = iterations;
+    settings.rock_margin_fraction = margin_fraction;
     RigidWorld w(settings);
     w.add_material("rock");
     w.add_material("ground");
