@@ -39,6 +39,8 @@ RigidWorld::RigidWorld(RigidSettings settings)
     require_non_negative(settings.split_impulse_threshold_m, "split_impulse_threshold_m", "rigid settings");
     require_positive(settings.rock_margin_m, "rock_margin_m", "rigid settings");
     require_in_range(settings.rock_margin_fraction, 1e-3, 0.5, "rock_margin_fraction", "rigid settings");
+    if (settings.contact_pool_size < 16 || settings.contact_pool_size > (1 << 22))
+        throw InputError(concat("rigid settings: contact_pool_size is ", settings.contact_pool_size, "; expected 16..4194304"));
     if (!is_finite(settings.gravity_m_per_s2)) throw InputError("rigid settings: gravity is not finite");
     impl_ = std::make_unique<Impl>(settings);
     gContactAddedCallback = pair_material_callback;

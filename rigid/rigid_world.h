@@ -30,6 +30,10 @@ struct RigidSettings {
     /// faces; only its sharpest corners are rounded (tests: volume within 1 %, extents within 2 %).
     double rock_margin_m = 0.02;
     double rock_margin_fraction = 0.05;
+    /// Contact manifolds and pair algorithms Bullet keeps in its fixed pools before it falls back to the
+    /// heap (slower, scattered in memory). Size it to the number of touching pairs expected (about 3.5 per
+    /// rock in a pile).
+    int contact_pool_size = 4096;
 };
 
 /// Position, orientation and velocities of a body's centre of mass, world frame.

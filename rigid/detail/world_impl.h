@@ -85,7 +85,15 @@ struct RigidWorld::Impl {
         }
     };
 
-    explicit Impl(const RigidSettings& s) : settings(s)
+    static btDefaultCollisionConstructionInfo pools(const RigidSettings& s)
+    {
+        btDefaultCollisionConstructionInfo info;
+        info.m_defaultMaxPersistentManifoldPoolSize = s.contact_pool_size;
+        info.m_defaultMaxCollisionAlgorithmPoolSize = s.contact_pool_size;
+        return info;
+    }
+
+    explicit Impl(const RigidSettings& s) : settings(s), config(pools(s))
     {
         world.setGravity(to_bt(s.gravity_m_per_s2));
         btContactSolverInfo& info = world.getSolverInfo();

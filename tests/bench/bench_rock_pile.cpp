@@ -2,7 +2,7 @@
 // the pile's weight. Rocks of the thesis' size classes (Table 1 mass fractions 300/400/600/850 mm =
 // 10/9/19/25) are dropped from a loose lattice onto the ground and settled; then steps are timed.
 // Usage: dipper_bench_rock_pile [--rocks N] [--dt S] [--settle-s S] [--settle-dt S] [--steps N] [--point-count N]
-//                               [--iterations N] [--margin-fraction F]
+//                               [--iterations N] [--margin-fraction F] [--pool N]
 // The pile settles at --settle-dt (default 1e-3 s), then takes 100 steps at --dt before the timed ones.
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"
@@ -24,7 +24,7 @@ using namespace dipper::rigid;
 
 int main(int argc, char** argv)
 {
-    int rocks = 1000, steps = 200, point_count = 20, iterations = 10;
+    int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 0;  // pool 0: 4 per rock
     double dt = 1e-3, settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
     for (int k = 1; k + 1 < argc; k += 2) {
         const std::string key = argv[k];
@@ -35,6 +35,7 @@ int main(int argc, char** argv)
         else if (key == "--steps") steps = std::atoi(argv[k + 1]);
         else if (key == "--point-count") point_count = std::atoi(argv[k + 1]);
         else if (key == "--iterations") iterations = std::atoi(argv[k + 1]);
+        else if (key == "--pool") pool = std::atoi(argv[k + 1]);
         else if (key == "--margin-fraction") margin_fraction = std::atof(argv[k + 1]);
         else {
             std::fprintf(stderr, "unknown option %s\n", argv[k]);
@@ -44,6 +45,7 @@ int main(int argc, char** argv)
     RigidSettings settings;
     settings.step_s = settle_dt;
     settings.solver_iterations = iterations;
+    settings.contact_pool_size = pool > 0 ? pool : std::max(4096, 4 * rocks);
     settings.rock_margin_fraction = margin_fraction;
     RigidWorld w(settings);
     w.add_material("rock");
