@@ -24,7 +24,7 @@ using namespace dipper::rigid;
 
 int main(int argc, char** argv)
 {
-    int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 0;  // pool 0: 4 per rock
+    int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 4096;
     double dt = 1e-3, settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
     for (int k = 1; k + 1 < argc; k += 2) {
         const std::string key = argv[k];
@@ -45,7 +45,7 @@ int main(int argc, char** argv)
     RigidSettings settings;
     settings.step_s = settle_dt;
     settings.solver_iterations = iterations;
-    settings.contact_pool_size = pool > 0 ? pool : std::max(4096, 4 * rocks);
+    settings.contact_pool_size = pool;
     settings.rock_margin_fraction = margin_fraction;
     RigidWorld w(settings);
     w.add_material("rock");
