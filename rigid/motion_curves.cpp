@@ -1,5 +1,6 @@
 #include "rigid/motion_curves.h"
 
+#include "core/csv.h"
 #include "core/errors.h"
 #include "core/files.h"
 
@@ -12,13 +13,6 @@
 namespace dipper::rigid {
 
 namespace {
-
-std::string trim(const std::string& s)
-{
-    const auto a = s.find_first_not_of(" \t\r");
-    if (a == std::string::npos) return {};
-    return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
 
 const std::vector<std::string>& columns()
 {
@@ -61,10 +55,7 @@ MotionCurves MotionCurves::from_csv(const std::string& path)
         ++number;
         const std::string text = trim(line);
         if (text.empty() || text[0] == '#') continue;
-        std::vector<std::string> cells;
-        std::stringstream ss(text);
-        std::string cell;
-        while (std::getline(ss, cell, ',')) cells.push_back(trim(cell));
+        const std::vector<std::string> cells = split_csv_line(text);
         const std::string where = concat(path, ":", number);
         if (column.empty()) {
             for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -81,19 +72,7 @@ MotionCurves MotionCurves::from_csv(const std::string& path)
         }
         if (cells.size() != column.size())
             throw InputError(concat(where, ": ", cells.size(), " values; the header has ", column.size(), " columns"));
-        const auto value = [&](const std::string& name) {
-            const std::string& t = cells[column[name]];
-            std::size_t used = 0;
-            double v = std::nan("");
-            try {
-                v = std::stod(t, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            if (used == 0 || used != t.size() || !std::isfinite(v))
-                throw InputError(concat(where, ": column '", name, "' has '", t, "'; expected a finite number"));
-            return v;
-        };
+        const auto value = [&](const std::string& name) { return parse_csv_number(cells[column[name]], where, name); };
         MotionSample s{value("time_s"), value("hoist_length_m"), value("crowd_extension_m"), value("swing_deg"), value("door_deg")};
         if (!(s.time_s > last_time))
             throw InputError(concat(where, ": time_s ", s.time_s, " is not after the previous time ", last_time,

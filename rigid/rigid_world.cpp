@@ -250,11 +250,20 @@ void RigidWorld::step()
 {
     const double dt = impl_->settings.step_s;
     if (impl_->checked_bodies != impl_->bodies.size()) impl_->check_pairs();
-    for (auto& b : impl_->bodies)
-        if (b->multibody) b->previous_pose = b->link_collider->getWorldTransform();
+    impl_->velocity_before.resize(impl_->bodies.size());
+    impl_->spin_before.resize(impl_->bodies.size());
+    for (std::size_t k = 0; k < impl_->bodies.size(); ++k) {
+        Impl::Body& b = *impl_->bodies[k];
+        if (b.multibody) b.previous_pose = b.link_collider->getWorldTransform();
+        if (b.is_rock()) {
+            impl_->velocity_before[k] = b.body->getLinearVelocity();
+            impl_->spin_before[k] = b.body->getAngularVelocity();
+        }
+    }
     if (impl_->shovel) shovel_before_step(*impl_, impl_->time_s + dt);
     impl_->world.stepSimulation(dt, 0);  // maxSubSteps = 0: exactly one step of dt, no interpolation
     impl_->time_s += dt;
+    ++impl_->step_count;
     if (impl_->shovel) shovel_after_step(*impl_);
 
     std::fill(impl_->contact_force.begin(), impl_->contact_force.end(), Vec3{});
@@ -339,6 +348,8 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
     const btTransform to_part = (part.object()->getWorldTransform() * part.part_in_object).inverse();
     const double dt = impl_->settings.step_s;
     std::vector<ContactRecord> out;
+    std::vector<const void*> now_touching;
+    const bool continues = part.touching_step + 1 == impl_->step_count;  // reported for the step before too
     btDispatcher& d = impl_->dispatcher;
     for (int q = 0; q < d.getNumManifolds(); ++q) {
         const btPersistentManifold* m = d.getManifoldByIndexInternal(q);
@@ -347,8 +358,19 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
         if (!surface_is_a && !surface_is_b) continue;
         const auto* other = btRigidBody::upcast(surface_is_a ? m->getBody1() : m->getBody0());
         if (!other || other->getInvMass() == 0.0) continue;  // rocks only
+        // An impact is the start of contact between the rock and the part: the first touching point of a
+        // manifold that did not touch in the previous step. (Bullet keeps points a little apart in its
+        // manifolds, and adds a landing face's points over several steps; neither is a new impact.)
+        const auto touches = [](const btManifoldPoint& p) { return p.getDistance() <= 0.0 || p.m_appliedImpulse > 0.0; };
+        bool touching = false;
+        for (int k = 0; k < m->getNumContacts(); ++k) touching = touching || touches(m->getContactPoint(k));
+        if (!touching) continue;
+        now_touching.push_back(m);
+        const bool new_contact = !continues || !std::binary_search(part.touching.begin(), part.touching.end(), static_cast<const void*>(m));
+        bool impact_given = false;
         for (int k = 0; k < m->getNumContacts(); ++k) {
             const btManifoldPoint& p = m->getContactPoint(k);
+            if (!touches(p)) continue;
             const double sign = surface_is_b ? 1.0 : -1.0;  // the normal points from B to A
             const Vec3 n = from_bt(p.m_normalWorldOnB) * sign;
             const Vec3 friction_on_a = (from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
@@ -359,7 +381,15 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
             r.normal_force_N = p.m_appliedImpulse / dt;
             r.tangential_force_N = friction_on_a * sign;
             const btVector3 at = surface_is_b ? p.getPositionWorldOnA() : p.getPositionWorldOnB();
-            const btVector3 v_other = other->getVelocityInLocalPoint(at - other->getCenterOfMassPosition());
+            r.first_step = new_contact && !impact_given;
+            impact_given = impact_given || r.first_step;
+            // Bullet resolves an impact within one step, so the velocity after it is the rebound: an impact's
+            // record takes the rock's velocity from the start of the step (the approach)
+            const auto o = static_cast<std::size_t>(other->getUserIndex2());
+            const btVector3 arm = at - other->getCenterOfMassPosition();
+            const btVector3 v_other = r.first_step && o < impl_->velocity_before.size()
+                                          ? impl_->velocity_before[o] + impl_->spin_before[o].cross(arm)
+                                          : other->getVelocityInLocalPoint(arm);
             const btVector3 v_self = part.velocity_at(to_bt(r.point_world), dt);
             r.relative_displacement_m = from_bt(v_other - v_self) * dt;
             r.overlap_m = std::max(0.0, -p.getDistance());
@@ -369,10 +399,12 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
             if (wear_mesh) r.triangle_id = part.locator->nearest(from_bt(to_part * to_bt(r.point_world))).triangle;
             r.particle_index = other->getUserIndex2();
             r.particle_mass_kg = 1.0 / other->getInvMass();
-            r.first_step = p.getLifeTime() <= 1;
             out.push_back(r);
         }
     }
+    std::sort(now_touching.begin(), now_touching.end());
+    part.touching.swap(now_touching);
+    part.touching_step = impl_->step_count;
     return out;
 }
 

@@ -124,6 +124,9 @@ public:
     /// triangle. `surface_id` is written into the records. Rocks only (not plane-plane or mesh-mesh).
     /// With `wear_mesh` (the part's surface mesh in its own frame) each record's triangle is the wear-mesh
     /// triangle nearest to the contact point; without it, the Bullet mesh's own triangle (-1 for plates).
+    /// Only touching points are reported. One record per start of contact between a rock and the part has
+    /// first_step set (an impact), with the rock's velocity from before the step: call this once per step
+    /// for a part, since it tells a new contact from one that continues by the previous call.
     std::vector<ContactRecord> surface_contacts(BodyId surface, std::int32_t surface_id,
                                                 const meshes::TriangleMesh* wear_mesh = nullptr) const;
     std::size_t contact_point_count() const;

@@ -1,5 +1,6 @@
 #include "wear/calibration.h"
 
+#include "core/csv.h"
 #include "core/errors.h"
 #include "core/files.h"
 
@@ -14,38 +15,6 @@
 namespace dipper::wear {
 
 namespace {
-
-std::string trim(const std::string& s)
-{
-    const auto begin = s.find_first_not_of(" \t\r");
-    if (begin == std::string::npos) return {};
-    const auto end = s.find_last_not_of(" \t\r");
-    return s.substr(begin, end - begin + 1);
-}
-
-std::vector<std::string> split_csv_line(const std::string& line)
-{
-    std::vector<std::string> cells;
-    std::stringstream in(line);
-    std::string cell;
-    while (std::getline(in, cell, ',')) cells.push_back(trim(cell));
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
-    return cells;
-}
-
-double parse_number(const std::string& text, const std::string& where, const std::string& column)
-{
-    std::size_t used = 0;
-    double value = std::numeric_limits<double>::quiet_NaN();
-    try {
-        value = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used == 0 || used != text.size() || !std::isfinite(value))
-        throw InputError(concat(where, ": column '", column, "' has '", text, "'; expected a finite number"));
-    return value;
-}
 
 /// Closest point on a polyline: arc length there and the distance.
 std::pair<double, double> project_on_polyline(const std::vector<Vec3>& line, const Vec3& p)
@@ -101,7 +70,7 @@ std::vector<MeasuredPoint> read_measured_points(const std::string& path)
         p.id = cells[column["id"]];
         if (p.id.empty()) throw InputError(concat(where, ": empty id"));
         if (!ids.insert(p.id).second) throw InputError(concat(where, ": id '", p.id, "' appears twice"));
-        const auto number = [&](const char* name) { return parse_number(cells[column[name]], where, name); };
+        const auto number = [&](const char* name) { return parse_csv_number(cells[column[name]], where, name); };
         p.position_m = {number("x_m"), number("y_m"), number("z_m")};
         p.depth_mm = number("depth_mm");
         p.tonnage_t = number("tonnage_t");

@@ -73,6 +73,8 @@ struct RigidWorld::Impl {
         int link = -1;
         btTransform previous_pose = btTransform::getIdentity();  ///< for link velocities by finite difference
         btTransform part_in_object = btTransform::getIdentity();  ///< the part's own frame in the object's frame
+        std::vector<const void*> touching;  ///< manifolds with this part that touched in the last reported step
+        std::uint64_t touching_step = 0;
 
         btCollisionObject* object() const { return body ? static_cast<btCollisionObject*>(body.get()) : link_collider.get(); }
         bool is_rock() const { return body && body->getInvMass() > 0.0; }
@@ -115,7 +117,9 @@ struct RigidWorld::Impl {
     MaterialPairs pairs;
     std::size_t checked_bodies = 0;  // bodies whose material pairs have been checked
     double time_s = 0.0;
+    std::uint64_t step_count = 0;
     std::vector<Vec3> contact_force;
+    std::vector<btVector3> velocity_before, spin_before;  // of each rock at the start of the last step
 
     Body& body(BodyId id, const char* what)
     {
