@@ -1,5 +1,7 @@
 #include "dem/walls.h"
 
+#include "core/errors.h"
+
 #include <cmath>
 #include <utility>
 
@@ -38,6 +40,13 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
     } else {
         set_pose(Mat3::identity(), Vec3{}, Vec3{}, Vec3{}, Vec3{});
     }
+}
+
+void MeshWall::set_mass_kg(double mass_kg)
+{
+    if (!(mass_kg >= 0.0) || !std::isfinite(mass_kg))
+        throw InputError(concat("mesh wall '", name_, "': mass_kg = ", mass_kg, "; expected a finite value >= 0 (0: immovable)"));
+    mass_kg_ = mass_kg;
 }
 
 void MeshWall::set_pose(const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_world_m,

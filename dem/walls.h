@@ -57,6 +57,12 @@ public:
     const std::vector<Vec3>& vertices_world_m() const { return vertices_world_; }
     const Vec3& normal_world(std::size_t t) const { return normals_world_[t]; }
     const Vec3& angular_velocity_rad_per_s() const { return angular_velocity_; }
+    /// The point whose velocity set_pose gave (a rigid body's centre of mass), world frame.
+    const Vec3& reference_point_m() const { return reference_point_; }
+    /// Mass of the body behind the wall; 0 (the default) is immovable. A finite mass makes the contact
+    /// damping use the pair's effective mass m1 m2 / (m1 + m2) (DESIGN 1.1).
+    double mass_kg() const { return mass_kg_; }
+    void set_mass_kg(double mass_kg);
     const std::optional<PrescribedMotion>& motion() const { return motion_; }
     MaterialIndex material() const { return material_; }
     const std::string& name() const { return name_; }
@@ -76,6 +82,7 @@ private:
     std::vector<Vec3> vertices_world_;
     std::vector<Vec3> normals_world_;
     std::uint64_t pose_version_ = 0;
+    double mass_kg_ = 0.0;
 };
 
 }  // namespace dipper::dem

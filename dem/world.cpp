@@ -76,6 +76,7 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
     walls_.push_back({false, static_cast<int>(planes_.size() - 1)});
     plane_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
     wall_force_N_.resize(walls_.size());
+    wall_torque_N_m_.resize(walls_.size());
     rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
@@ -103,6 +104,7 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
     walls_.push_back({true, static_cast<int>(meshes_.size() - 1)});
     mesh_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
     wall_force_N_.resize(walls_.size());
+    wall_torque_N_m_.resize(walls_.size());
     rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
@@ -144,6 +146,33 @@ Vec3 World::wall_force_N(int wall_id) const
 {
     is_mesh(wall_id);  // validates the id
     return wall_force_N_[static_cast<std::size_t>(wall_id)];
+}
+
+Vec3 World::wall_torque_N_m(int wall_id) const
+{
+    is_mesh(wall_id);
+    return wall_torque_N_m_[static_cast<std::size_t>(wall_id)];
+}
+
+void World::set_wall_mass_kg(int wall_id, double mass_kg)
+{
+    if (!is_mesh(wall_id)) throw InputError(concat("set_wall_mass_kg: wall '", wall_name(wall_id), "' is a plane, which is immovable"));
+    meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index)].set_mass_kg(mass_kg);
+}
+
+void World::sum_wall_reactions()
+{
+    // in list order, so the sums are deterministic
+    std::fill(wall_force_N_.begin(), wall_force_N_.end(), Vec3{});
+    std::fill(wall_torque_N_m_.begin(), wall_torque_N_m_.end(), Vec3{});
+    for (const WallContact& c : wall_contacts_) {
+        const auto w = static_cast<std::size_t>(c.wall);
+        const Vec3 on_wall = -(c.normal * c.forces.normal_force_N + c.forces.tangential_force_N);
+        const WallRef& ref = walls_[w];
+        const Vec3 about = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].reference_point_m() : Vec3{};
+        wall_force_N_[w] += on_wall;
+        wall_torque_N_m_[w] += cross(c.point - about, on_wall) - c.forces.rolling_torque_N_m;
+    }
 }
 
 // ---- time step -----------------------------------------------------------------------------------
@@ -213,6 +242,7 @@ void World::prepare()
         // velocity Verlet starts from the forces of the initial state; a zero-length step leaves the
         // contact springs where they are
         evaluate_forces(0.0, 0.0);
+        sum_wall_reactions();
         prepared_ = true;
     }
 }
@@ -297,10 +327,7 @@ void World::finish_step(double dt_s)
     time_s_ += dt_s;
     ++step_count_;
 
-    // wall reactions: sum in list order (deterministic)
-    std::fill(wall_force_N_.begin(), wall_force_N_.end(), Vec3{});
-    for (const WallContact& c : wall_contacts_)
-        wall_force_N_[static_cast<std::size_t>(c.wall)] -= c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
+    sum_wall_reactions();
 
     // surface contact records for consumers (wear)
     records_.resize(wall_contacts_.size());
@@ -777,7 +804,9 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         s.relative_velocity_m_per_s = v + cross(w, arm) - wall_velocity;
         s.relative_angular_velocity_rad_per_s = w - wall_spin;
         s.effective_radius_m = r;
-        s.effective_mass_kg = particles_.mass_kg[i];
+        const double wall_mass = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].mass_kg() : 0.0;
+        s.effective_mass_kg = wall_mass > 0.0 ? particles_.mass_kg[i] * wall_mass / (particles_.mass_kg[i] + wall_mass)
+                                              : particles_.mass_kg[i];
         s.normal_stiffness_N_per_m = wall_normal_stiffness(bulk_modulus_Pa_[particles_.material[i]], r, p.normal_stiffness_scale);
         c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
         c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;

@@ -58,6 +58,8 @@ public:
     /// Moves a mesh wall rigidly (used by code that drives machine parts); takes effect for the next step.
     void set_mesh_pose(int wall_id, const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_m,
                        const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s);
+    /// Mass of the body behind a mesh wall (0: immovable), for the damping's effective mass.
+    void set_wall_mass_kg(int wall_id, double mass_kg);
     /// Receives every sphere-wall contact of each step (see core/contact_record.h).
     void set_contact_consumer(ContactConsumer consumer) { consumer_ = std::move(consumer); }
 
@@ -92,6 +94,12 @@ public:
 
     /// Total force the particles exert on a wall during the last step, N (deterministic sum).
     Vec3 wall_force_N(int wall_id) const;
+    /// Torque of the same forces (and of the rolling resistance) about the wall's reference point (a mesh
+    /// wall's MeshWall::reference_point_m, the origin for a plane), N m. After the first step or prepare().
+    Vec3 wall_torque_N_m(int wall_id) const;
+    /// Builds the neighbour lists and computes the forces of the initial state, as the first step would;
+    /// wall forces and torques are then those of the initial state. Called by step() when needed.
+    void prepare();
     /// Surface contacts of the last step.
     const std::vector<ContactRecord>& last_contact_records() const { return records_; }
     std::size_t pair_contact_count() const;          ///< touching sphere pairs in the last step
@@ -130,7 +138,7 @@ private:
         bool keep;
     };
 
-    void prepare();
+    void sum_wall_reactions();
     void check_wall_name(const std::string& name) const;
     void validate_step();
     void check_initial_overlaps() const;
@@ -183,7 +191,7 @@ private:
     std::vector<MeshCandidate> candidates_;
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
-    std::vector<Vec3> wall_force_N_;
+    std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
     std::vector<ContactRecord> records_;
     double max_overlap_ratio_ = 0.0;
 };

@@ -246,6 +246,41 @@ void RigidWorld::apply_force(BodyId id, const Vec3& force, const Vec3& point)
     b.body->applyForce(to_bt(force), to_bt(point) - b.body->getCenterOfMassPosition());
 }
 
+void RigidWorld::apply_force_and_torque(BodyId id, const Vec3& force, const Vec3& torque)
+{
+    Impl::Body& b = impl_->body(id, "apply_force_and_torque");
+    if (!is_finite(force) || !is_finite(torque))
+        throw SimulationError(concat("apply_force_and_torque on '", b.name, "': force or torque is not finite at t = ",
+                                     impl_->time_s, " s"));
+    if (b.multibody) {
+        if (b.link < 0) {
+            b.multibody->addBaseForce(to_bt(force));
+            b.multibody->addBaseTorque(to_bt(torque));
+        } else {
+            b.multibody->addLinkForce(b.link, to_bt(force));
+            b.multibody->addLinkTorque(b.link, to_bt(torque));
+        }
+        return;
+    }
+    if (b.body->getInvMass() == 0.0) return;
+    b.body->applyCentralForce(to_bt(force));
+    b.body->applyTorque(to_bt(torque));
+}
+
+void RigidWorld::part_pose(BodyId id, Mat3& rotation, Vec3& origin_m) const
+{
+    const Impl::Body& b = impl_->body(id, "part_pose");
+    const btTransform t = b.object()->getWorldTransform() * b.part_in_object;
+    rotation = from_bt(t.getBasis());
+    origin_m = from_bt(t.getOrigin());
+}
+
+bool RigidWorld::is_dynamic(BodyId id) const
+{
+    const Impl::Body& b = impl_->body(id, "is_dynamic");
+    return b.multibody != nullptr || b.is_rock();
+}
+
 void RigidWorld::step()
 {
     const double dt = impl_->settings.step_s;
@@ -319,6 +354,31 @@ double RigidWorld::max_penetration_m() const
         for (int k = 0; k < m->getNumContacts(); ++k) deepest = std::max(deepest, -m->getContactPoint(k).getDistance());
     }
     return deepest;
+}
+
+Vec3 RigidWorld::linear_momentum_kg_m_per_s() const
+{
+    Vec3 p;
+    for (const auto& b : impl_->bodies)
+        if (b->is_rock()) p += from_bt(b->body->getLinearVelocity()) * (1.0 / b->body->getInvMass());
+    return p;
+}
+
+Vec3 RigidWorld::angular_momentum_kg_m2_per_s() const
+{
+    Vec3 l;
+    for (const auto& b : impl_->bodies) {
+        if (!b->is_rock()) continue;
+        const btRigidBody* body = b->body.get();
+        const btMatrix3x3& basis = body->getWorldTransform().getBasis();
+        const btVector3 local_w = basis.transpose() * body->getAngularVelocity();
+        const btVector3 inv = body->getInvInertiaDiagLocal();
+        btVector3 local_l;
+        for (int k = 0; k < 3; ++k) local_l[k] = inv[k] > 0.0 ? local_w[k] / inv[k] : 0.0;
+        const Vec3 c = from_bt(body->getCenterOfMassPosition());
+        l += cross(c, from_bt(body->getLinearVelocity()) * (1.0 / body->getInvMass())) + from_bt(basis * local_l);
+    }
+    return l;
 }
 
 double RigidWorld::kinetic_energy_J() const

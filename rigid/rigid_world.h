@@ -88,6 +88,13 @@ public:
 
     /// Adds a force acting at a world point during the next step only (Bullet clears forces each step).
     void apply_force(BodyId body, const Vec3& force_N, const Vec3& point_world_m);
+    /// Adds a force at the centre of mass and a torque, for the next step only.
+    void apply_force_and_torque(BodyId body, const Vec3& force_N, const Vec3& torque_N_m);
+    /// Pose of the frame the body's shape was given in (x_world = R x_part + origin): a rock's principal
+    /// frame at its centroid, a mesh's or plate set's own frame, the dipper's and door's part frames.
+    void part_pose(BodyId body, Mat3& rotation, Vec3& origin_m) const;
+    /// True for bodies that move under forces (rocks, the shovel's dipper and door).
+    bool is_dynamic(BodyId body) const;
 
     // ---- the rope shovel (one per world)
     struct ShovelParts {
@@ -134,6 +141,9 @@ public:
     double max_penetration_m() const;
     /// Kinetic energy of the dynamic bodies (rocks), J.
     double kinetic_energy_J() const;
+    /// Linear momentum of the rocks, and their angular momentum about the origin (spins included).
+    Vec3 linear_momentum_kg_m_per_s() const;
+    Vec3 angular_momentum_kg_m2_per_s() const;
 
     struct Impl;  ///< Bullet's side, opaque outside rigid/
 

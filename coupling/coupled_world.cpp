@@ -1,0 +1,225 @@
+#include "coupling/coupled_world.h"
+
+#include "core/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <utility>
+
+namespace dipper::coupling {
+
+Vec3 rotation_vector(const Mat3& r)
+{
+    const auto& m = r.m;
+    const double trace = m[0][0] + m[1][1] + m[2][2];
+    const double cos_angle = std::clamp(0.5 * (trace - 1.0), -1.0, 1.0);
+    const double angle = std::acos(cos_angle);
+    const Vec3 skew{m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1]};  // 2 sin(angle) axis
+    if (angle < 1e-6) return skew * 0.5;                                        // sin(angle) ~ angle
+    if (angle < M_PI - 1e-3) return skew * (angle / (2.0 * std::sin(angle)));
+    // near a half turn sin(angle) is small: the axis from the diagonal of R = cos I + (1 - cos) a a^T + sin [a]x,
+    // its signs from the largest component's row, and the overall sign from the skew part
+    Vec3 a{std::sqrt(std::max(0.0, (m[0][0] - cos_angle) / (1.0 - cos_angle))),
+           std::sqrt(std::max(0.0, (m[1][1] - cos_angle) / (1.0 - cos_angle))),
+           std::sqrt(std::max(0.0, (m[2][2] - cos_angle) / (1.0 - cos_angle)))};
+    if (a.x >= a.y && a.x >= a.z) {
+        a.y = std::copysign(a.y, m[0][1] + m[1][0]);
+        a.z = std::copysign(a.z, m[0][2] + m[2][0]);
+    } else if (a.y >= a.z) {
+        a.x = std::copysign(a.x, m[0][1] + m[1][0]);
+        a.z = std::copysign(a.z, m[1][2] + m[2][1]);
+    } else {
+        a.x = std::copysign(a.x, m[0][2] + m[2][0]);
+        a.y = std::copysign(a.y, m[1][2] + m[2][1]);
+    }
+    if (dot(a, skew) < 0.0) a = a * -1.0;
+    return normalized(a) * angle;
+}
+
+CoupledWorld::CoupledWorld(dem::World& dem, rigid::RigidWorld& rigid, CouplingSettings settings)
+    : dem_(dem), rigid_(rigid), settings_(settings)
+{
+    if (settings_.substeps < 1)
+        throw InputError(concat("coupling substeps = ", settings_.substeps, "; expected a whole number >= 1 of DEM steps per rigid-body step"));
+}
+
+int CoupledWorld::couple(rigid::BodyId body, meshes::TriangleMesh surface, dem::MaterialIndex material, const std::string& name)
+{
+    const std::string& body_name = rigid_.body_name(body);  // validates the id
+    if (index_of(body) >= 0) throw InputError(concat("couple: rigid body '", body_name, "' is coupled already"));
+    if (surface.triangle_count() == 0)
+        throw InputError(concat("couple: rigid body '", body_name, "' was given a surface '", name,
+                                "' with no triangles; the spheres need a collision surface to touch"));
+    if (material >= dem_.materials().size())
+        throw InputError(concat("couple: rigid body '", body_name, "': DEM material index ", material, " does not exist"));
+    CoupledBody b;
+    b.body = body;
+    b.dynamic = rigid_.is_dynamic(body);
+    b.wall = dem_.add_mesh(std::move(surface), material, name);
+    if (b.dynamic && rigid_.mass_kg(body) > 0.0) dem_.set_wall_mass_kg(b.wall, rigid_.mass_kg(body));
+    bodies_.push_back(b);
+    // the surface starts where the body is, moving as it moves
+    const Pose p = pose_of(b);
+    const rigid::BodyState s = rigid_.state(body);
+    dem_.set_mesh_pose(b.wall, p.rotation, p.origin_m, p.centre_m, s.velocity_m_per_s, s.angular_velocity_rad_per_s);
+    before_.push_back(p);
+    after_.push_back(p);
+    spin_rad_.push_back({});
+    force_sum_.push_back({});
+    torque_sum_.push_back({});
+    return static_cast<int>(bodies_.size() - 1);
+}
+
+rigid::BodyId CoupledWorld::add_rock(const rigid::ConvexPolyhedron& shape, double density_kg_per_m3, int rigid_material,
+                                     dem::MaterialIndex dem_material, const Vec3& position_m, const Mat3& rotation,
+                                     const Vec3& velocity_m_per_s, const Vec3& angular_velocity_rad_per_s)
+{
+    const rigid::BodyId id = rigid_.add_rock(shape, density_kg_per_m3, rigid_material, position_m, rotation,
+                                             velocity_m_per_s, angular_velocity_rad_per_s);
+    std::string name = rigid_.body_name(id);  // "rock 12" -> DEM wall "rock_12" (wall names are file-name safe)
+    std::replace(name.begin(), name.end(), ' ', '_');
+    couple(id, shape.to_mesh(), dem_material, name);
+    return id;
+}
+
+const CoupledBody& CoupledWorld::body(int index) const
+{
+    if (index < 0 || static_cast<std::size_t>(index) >= bodies_.size())
+        throw InputError(concat("coupled body ", index, " does not exist; there are ", bodies_.size()));
+    return bodies_[static_cast<std::size_t>(index)];
+}
+
+int CoupledWorld::index_of(rigid::BodyId body) const
+{
+    for (std::size_t k = 0; k < bodies_.size(); ++k)
+        if (bodies_[k].body == body) return static_cast<int>(k);
+    return -1;
+}
+
+Vec3 CoupledWorld::mean_sphere_force_N(int index) const
+{
+    body(index);
+    return samples_ > 0 ? force_sum_[static_cast<std::size_t>(index)] * (1.0 / samples_) : Vec3{};
+}
+
+Vec3 CoupledWorld::mean_sphere_torque_N_m(int index) const
+{
+    body(index);
+    return samples_ > 0 ? torque_sum_[static_cast<std::size_t>(index)] * (1.0 / samples_) : Vec3{};
+}
+
+CoupledWorld::Pose CoupledWorld::pose_of(const CoupledBody& b) const
+{
+    Pose p;
+    rigid_.part_pose(b.body, p.rotation, p.origin_m);
+    p.centre_m = rigid_.state(b.body).position_m;
+    return p;
+}
+
+void CoupledWorld::check_pairs() const
+{
+    std::set<dem::MaterialIndex> present(dem_.particles().material.begin(), dem_.particles().material.end());
+    const dem::MaterialTable& table = dem_.materials();
+    for (std::size_t k = checked_bodies_; k < bodies_.size(); ++k) {
+        const dem::MaterialIndex wall_material = dem_.mesh_wall(bodies_[k].wall).material();
+        for (dem::MaterialIndex m : present)
+            if (!table.has_pair(m, wall_material))
+                throw InputError(concat("coupled body '", rigid_.body_name(bodies_[k].body), "' (DEM material '",
+                                        table.material(wall_material).name, "') and spheres of material '",
+                                        table.material(m).name, "': no contact coefficients for this pair; set them with "
+                                        "MaterialTable::set_pair (or the scenario's pairs)"));
+    }
+}
+
+void CoupledWorld::start()
+{
+    const double dt = dem_.step_s();
+    if (!(dt > 0.0)) throw InputError("coupling: the DEM has no time step yet (no particles and step_s = 0)");
+    rigid_.set_step_s(dt * settings_.substeps);
+    // the reaction of the initial state is the first one Bullet receives
+    dem_.prepare();
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        force_sum_[k] = dem_.wall_force_N(bodies_[k].wall);
+        torque_sum_[k] = dem_.wall_torque_N_m(bodies_[k].wall);
+    }
+    samples_ = 1;
+    started_ = true;
+}
+
+void CoupledWorld::move_surfaces(double fraction)
+{
+    const double interval = coupling_step_s();
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        const Pose& a = before_[k];
+        const Pose& b = after_[k];
+        const Vec3 spin = spin_rad_[k];
+        const double angle = norm(spin);
+        const Mat3 turn = angle > 0.0 ? rotation_about_axis(spin * (1.0 / angle), angle * fraction) : Mat3::identity();
+        const Mat3 rotation = turn * a.rotation;
+        const Vec3 centre = a.centre_m + (b.centre_m - a.centre_m) * fraction;
+        const Vec3 origin = centre + turn * (a.origin_m - a.centre_m);
+        dem_.set_mesh_pose(bodies_[k].wall, rotation, origin, centre, (b.centre_m - a.centre_m) * (1.0 / interval),
+                           spin * (1.0 / interval));
+    }
+}
+
+void CoupledWorld::step()
+{
+    if (checked_bodies_ != bodies_.size()) {
+        check_pairs();
+        checked_bodies_ = bodies_.size();
+    }
+    if (!started_) start();
+
+    // 1. Bullet steps with the spheres' mean reaction from the last sub-steps
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        CoupledBody& b = bodies_[k];
+        b.applied_force_N = samples_ > 0 ? force_sum_[k] * (1.0 / samples_) : Vec3{};
+        b.applied_torque_N_m = samples_ > 0 ? torque_sum_[k] * (1.0 / samples_) : Vec3{};
+        if (b.dynamic) rigid_.apply_force_and_torque(b.body, b.applied_force_N, b.applied_torque_N_m);
+        before_[k] = pose_of(b);
+        force_sum_[k] = Vec3{};
+        torque_sum_[k] = Vec3{};
+    }
+    samples_ = 0;
+    rigid_.step();
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        after_[k] = pose_of(bodies_[k]);
+        spin_rad_[k] = rotation_vector(after_[k].rotation * before_[k].rotation.transposed());
+    }
+
+    // 2. and 3. the DEM sub-steps, the surfaces moving from the old poses to the new ones
+    const int n = settings_.substeps;
+    for (int s = 1; s <= n; ++s) {
+        move_surfaces(static_cast<double>(s) / n);
+        dem_.step();
+        for (std::size_t k = 0; k < bodies_.size(); ++k) {
+            force_sum_[k] += dem_.wall_force_N(bodies_[k].wall);
+            torque_sum_[k] += dem_.wall_torque_N_m(bodies_[k].wall);
+        }
+        ++samples_;
+    }
+}
+
+void CoupledWorld::run_steps(std::uint64_t n)
+{
+    for (std::uint64_t s = 0; s < n; ++s) step();
+}
+
+Vec3 CoupledWorld::linear_momentum_kg_m_per_s() const
+{
+    return dem_.linear_momentum_kg_m_per_s() + rigid_.linear_momentum_kg_m_per_s();
+}
+
+Vec3 CoupledWorld::angular_momentum_kg_m2_per_s() const
+{
+    return dem_.angular_momentum_kg_m2_per_s() + rigid_.angular_momentum_kg_m2_per_s();
+}
+
+double CoupledWorld::kinetic_energy_J() const
+{
+    return dem_.kinetic_energy_J() + rigid_.kinetic_energy_J();
+}
+
+}  // namespace dipper::coupling

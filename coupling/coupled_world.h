@@ -1,0 +1,111 @@
+// Spheres and rigid bodies in one time loop (DESIGN 1.3 and 3). The only module that sees both the DEM
+// and Bullet's side: a rigid body the spheres may touch is a mesh wall in the DEM (a rock by its convex
+// hull, a machine part by its surface mesh) that follows the body, and the spheres' reaction goes back to
+// the body as a force and a torque about its centre of mass.
+#pragma once
+
+#include "core/vec3.h"
+#include "dem/world.h"
+#include "meshes/triangle_mesh.h"
+#include "rigid/convex_polyhedron.h"
+#include "rigid/rigid_world.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dipper::coupling {
+
+struct CouplingSettings {
+    /// DEM steps per rigid-body step (DESIGN 1.3). 1 exchanges forces every DEM step; larger values give
+    /// Bullet one step of substeps x the DEM step with the mean reaction of the sub-steps.
+    int substeps = 1;
+};
+
+/// A rigid body the spheres touch, and what passed between the two at the last step.
+struct CoupledBody {
+    rigid::BodyId body = -1;
+    int wall = -1;           ///< the DEM mesh wall that carries its surface
+    bool dynamic = false;    ///< receives the spheres' reaction (rocks, the dipper, the door)
+    Vec3 applied_force_N;    ///< force Bullet's last step received from the spheres
+    Vec3 applied_torque_N_m; ///< torque about the centre of mass Bullet's last step received
+};
+
+/// The coupled step. Both worlds stay usable on their own (add walls, planes and particles to the DEM,
+/// ground and rock-rock contacts to Bullet); this class moves the coupled surfaces and exchanges forces.
+///
+/// One step of the coupling is `substeps` DEM steps and one Bullet step of the same length:
+///   1. Bullet steps with the spheres' mean reaction from the previous coupling step's sub-steps
+///      (force and torque about each body's centre of mass, as sampled at those configurations);
+///   2. each coupled surface moves through the DEM sub-steps from its pose before that Bullet step to its
+///      pose after it, at the constant velocity that joins them (the velocity Bullet integrated with);
+///   3. each DEM sub-step computes sphere forces against those surfaces and the reactions are summed.
+/// Forces are thus always evaluated at a configuration both sides share; with substeps = 1 the exchange is
+/// the staggered scheme in which each impulse the spheres receive, the body receives too, so a closed
+/// system keeps its linear momentum to round-off (docs/coupling.md).
+class CoupledWorld {
+public:
+    CoupledWorld(dem::World& dem, rigid::RigidWorld& rigid, CouplingSettings settings = {});
+
+    /// Lets the spheres touch `body` through `surface`, a closed or open triangle mesh in the body's part
+    /// frame (RigidWorld::part_pose), with DEM surface material `material`. Returns the coupled index.
+    int couple(rigid::BodyId body, meshes::TriangleMesh surface, dem::MaterialIndex material, const std::string& name);
+    /// A rock in both worlds: a Bullet body from `shape` (principal frame, RigidWorld::add_rock) and its hull
+    /// as a sphere surface of DEM material `dem_material`.
+    rigid::BodyId add_rock(const rigid::ConvexPolyhedron& shape, double density_kg_per_m3, int rigid_material,
+                           dem::MaterialIndex dem_material, const Vec3& position_m, const Mat3& rotation = Mat3::identity(),
+                           const Vec3& velocity_m_per_s = {}, const Vec3& angular_velocity_rad_per_s = {});
+
+    /// One coupling step (substeps DEM steps). Throws SimulationError with a diagnosis if either side blows up.
+    void step();
+    void run_steps(std::uint64_t n);
+
+    double time_s() const { return dem_.time_s(); }
+    double dem_step_s() const { return dem_.step_s(); }
+    double coupling_step_s() const { return dem_.step_s() * settings_.substeps; }
+    const CouplingSettings& settings() const { return settings_; }
+    const std::vector<CoupledBody>& bodies() const { return bodies_; }
+    const CoupledBody& body(int index) const;
+    /// Index of a coupled body by its rigid body id, or -1.
+    int index_of(rigid::BodyId body) const;
+    /// Mean force and torque the spheres exerted on a coupled body over the sub-steps of the last step (what
+    /// Bullet receives at the next step).
+    Vec3 mean_sphere_force_N(int index) const;
+    Vec3 mean_sphere_torque_N_m(int index) const;
+
+    dem::World& dem() { return dem_; }
+    rigid::RigidWorld& rigid() { return rigid_; }
+    const dem::World& dem() const { return dem_; }
+    const rigid::RigidWorld& rigid() const { return rigid_; }
+
+    // ---- whole-system balances (tests, probes)
+    Vec3 linear_momentum_kg_m_per_s() const;   ///< spheres and dynamic rocks
+    Vec3 angular_momentum_kg_m2_per_s() const; ///< about the origin, spins included
+    double kinetic_energy_J() const;
+
+private:
+    struct Pose {
+        Mat3 rotation;
+        Vec3 origin_m, centre_m;
+    };
+    Pose pose_of(const CoupledBody& b) const;
+    void start();
+    void check_pairs() const;
+    void move_surfaces(double fraction);
+
+    dem::World& dem_;
+    rigid::RigidWorld& rigid_;
+    CouplingSettings settings_;
+    std::vector<CoupledBody> bodies_;
+    std::vector<Pose> before_, after_;
+    std::vector<Vec3> spin_rad_;             ///< rotation vector from `before_` to `after_`
+    std::vector<Vec3> force_sum_, torque_sum_;
+    int samples_ = 0;
+    bool started_ = false;
+    std::size_t checked_bodies_ = 0;
+};
+
+/// Rotation vector (axis times angle, |angle| <= pi) of a rotation matrix.
+Vec3 rotation_vector(const Mat3& rotation);
+
+}  // namespace dipper::coupling
