@@ -28,6 +28,25 @@ inline dem::PairCoefficients coefficients(double friction, double rolling, doubl
     return {c_norm, c_tan, friction, rolling, damping_n, damping_t};
 }
 
+/// Exact response of the clamped linear spring-dashpot to an impact at speed v0 (unit v0 here):
+/// m x'' + c x' + K x = 0 while K x + c x' > 0, then force-free until the overlap closes.
+/// With theta = omega_d t, the force K x + c x' = m v0 omega0 e^{-zeta omega0 t} [omega0 (1 - 2 zeta^2)
+/// sin(theta) / omega_d + 2 zeta cos(theta)] first vanishes at theta* = pi - atan2(2 zeta omega_d,
+/// omega0 (1 - 2 zeta^2)). Restitution is -x'(t*) / v0; the contact lasts t* + x(t*) / |x'(t*)|.
+struct ClampedImpact {
+    double restitution, duration_s;
+};
+inline ClampedImpact clamped_impact(double zeta, double omega0)
+{
+    const double omega_d = omega0 * std::sqrt(1.0 - zeta * zeta);
+    const double theta = M_PI - std::atan2(2.0 * zeta * omega_d, omega0 * (1.0 - 2.0 * zeta * zeta));
+    const double t = theta / omega_d;
+    const double decay = std::exp(-zeta * omega0 * t);
+    const double x = decay * std::sin(theta) / omega_d;                                    // per unit v0
+    const double v = decay * (std::cos(theta) - zeta * omega0 / omega_d * std::sin(theta));  // < 0
+    return {-v, t + x / -v};
+}
+
 /// Bitwise hash of positions and velocities, in id order.
 inline std::uint64_t state_hash(const dem::World& w)
 {

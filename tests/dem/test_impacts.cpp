@@ -9,25 +9,6 @@ using namespace dipper::dem;
 
 namespace {
 
-/// Exact response of the clamped linear spring-dashpot to an impact at speed v0 (unit v0 here):
-/// m x'' + c x' + K x = 0 while K x + c x' > 0, then force-free until the overlap closes.
-/// With theta = omega_d t, the force K x + c x' = m v0 omega0 e^{-zeta omega0 t} [omega0 (1 - 2 zeta^2)
-/// sin(theta) / omega_d + 2 zeta cos(theta)] first vanishes at theta* = pi - atan2(2 zeta omega_d,
-/// omega0 (1 - 2 zeta^2)). Restitution is -x'(t*) / v0; the contact lasts t* + x(t*) / |x'(t*)|.
-struct ClampedImpact {
-    double restitution, duration_s;
-};
-ClampedImpact clamped_impact(double zeta, double omega0)
-{
-    const double omega_d = omega0 * std::sqrt(1.0 - zeta * zeta);
-    const double theta = M_PI - std::atan2(2.0 * zeta * omega_d, omega0 * (1.0 - 2.0 * zeta * zeta));
-    const double t = theta / omega_d;
-    const double decay = std::exp(-zeta * omega0 * t);
-    const double x = decay * std::sin(theta) / omega_d;                                    // per unit v0
-    const double v = decay * (std::cos(theta) - zeta * omega0 / omega_d * std::sin(theta));  // < 0
-    return {-v, t + x / -v};
-}
-
 struct Measured {
     double restitution = 0.0, duration_s = 0.0, peak_overlap_m = 0.0, peak_force_N = 0.0;
 };
@@ -95,7 +76,7 @@ TEST_CASE("normal impacts: restitution and duration match the exact clamped solu
         const double omega0 = std::sqrt(kn / (pair ? 0.5 * m : m));
         for (double damping : {0.0, 0.3, 0.6, 0.9}) {
             CAPTURE(pair, damping);
-            const ClampedImpact exact = clamped_impact(damping, omega0);
+            const test::ClampedImpact exact = test::clamped_impact(damping, omega0);
             const Measured got = run_impact(pair, damping, 1000.0);
             CHECK(got.restitution == Approx(exact.restitution).epsilon(5e-3));
             CHECK(got.duration_s == Approx(exact.duration_s).epsilon(5e-3));
