@@ -3,6 +3,7 @@
 #include "core/errors.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 #include <utility>
@@ -80,6 +81,7 @@ rigid::BodyId CoupledWorld::add_rock(const rigid::ConvexPolyhedron& shape, doubl
     std::string name = rigid_.body_name(id);  // "rock 12" -> DEM wall "rock_12" (wall names are file-name safe)
     std::replace(name.begin(), name.end(), ' ', '_');
     couple(id, shape.to_mesh(), dem_material, name);
+    rocks_.push_back({id, shape, density_kg_per_m3, rigid_material, dem_material});
     return id;
 }
 
@@ -154,6 +156,13 @@ void CoupledWorld::move_surfaces(double fraction)
         const Pose& a = before_[k];
         const Pose& b = after_[k];
         const Vec3 spin = spin_rad_[k];
+        if (!bodies_[k].dynamic && spin == Vec3{} && a.centre_m == b.centre_m && a.origin_m == b.origin_m) {
+            // a fixed part: place it once, at rest, and leave it (no vertex work, no neighbour-list churn)
+            const dem::MeshWall& wall = dem_.mesh_wall(bodies_[k].wall);
+            if (wall.velocity_at(wall.reference_point_m()) == Vec3{} && wall.angular_velocity_rad_per_s() == Vec3{} &&
+                wall.translation_m() == b.origin_m)
+                continue;
+        }
         const double angle = norm(spin);
         const Mat3 turn = angle > 0.0 ? rotation_about_axis(spin * (1.0 / angle), angle * fraction) : Mat3::identity();
         const Mat3 rotation = turn * a.rotation;
@@ -183,7 +192,10 @@ void CoupledWorld::step()
         torque_sum_[k] = Vec3{};
     }
     samples_ = 0;
+    auto mark = std::chrono::steady_clock::now();
     rigid_.step();
+    auto now = std::chrono::steady_clock::now();
+    rigid_seconds_ += std::chrono::duration<double>(now - mark).count();
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
         after_[k] = pose_of(bodies_[k]);
         spin_rad_[k] = rotation_vector(after_[k].rotation * before_[k].rotation.transposed());
@@ -192,7 +204,10 @@ void CoupledWorld::step()
     // 2. and 3. the DEM sub-steps, the surfaces moving from the old poses to the new ones
     const int n = settings_.substeps;
     for (int s = 1; s <= n; ++s) {
+        mark = std::chrono::steady_clock::now();
         move_surfaces(static_cast<double>(s) / n);
+        now = std::chrono::steady_clock::now();
+        surface_seconds_ += std::chrono::duration<double>(now - mark).count();
         dem_.step();
         for (std::size_t k = 0; k < bodies_.size(); ++k) {
             force_sum_[k] += dem_.wall_force_N(bodies_[k].wall);

@@ -31,6 +31,15 @@ struct CoupledBody {
     Vec3 applied_torque_N_m; ///< torque about the centre of mass Bullet's last step received
 };
 
+/// A rock made with CoupledWorld::add_rock: what it takes to make it again (saved states).
+struct RockRecord {
+    rigid::BodyId body = -1;
+    rigid::ConvexPolyhedron shape;  ///< principal frame
+    double density_kg_per_m3 = 0.0;
+    int rigid_material = 0;
+    dem::MaterialIndex dem_material = 0;
+};
+
 /// The coupled step. Both worlds stay usable on their own (add walls, planes and particles to the DEM,
 /// ground and rock-rock contacts to Bullet); this class moves the coupled surfaces and exchanges forces.
 ///
@@ -65,6 +74,7 @@ public:
     double coupling_step_s() const { return dem_.step_s() * settings_.substeps; }
     const CouplingSettings& settings() const { return settings_; }
     const std::vector<CoupledBody>& bodies() const { return bodies_; }
+    const std::vector<RockRecord>& rocks() const { return rocks_; }
     const CoupledBody& body(int index) const;
     /// Index of a coupled body by its rigid body id, or -1.
     int index_of(rigid::BodyId body) const;
@@ -77,6 +87,11 @@ public:
     rigid::RigidWorld& rigid() { return rigid_; }
     const dem::World& dem() const { return dem_; }
     const rigid::RigidWorld& rigid() const { return rigid_; }
+
+    /// Wall-clock seconds in Bullet's steps and in moving the coupled surfaces (the DEM's own phases are in
+    /// dem().phase_seconds()), summed since the start.
+    double rigid_seconds() const { return rigid_seconds_; }
+    double surface_seconds() const { return surface_seconds_; }
 
     // ---- whole-system balances (tests, probes)
     Vec3 linear_momentum_kg_m_per_s() const;   ///< spheres and dynamic rocks
@@ -97,10 +112,12 @@ private:
     rigid::RigidWorld& rigid_;
     CouplingSettings settings_;
     std::vector<CoupledBody> bodies_;
+    std::vector<RockRecord> rocks_;
     std::vector<Pose> before_, after_;
     std::vector<Vec3> spin_rad_;             ///< rotation vector from `before_` to `after_`
     std::vector<Vec3> force_sum_, torque_sum_;
     int samples_ = 0;
+    double rigid_seconds_ = 0.0, surface_seconds_ = 0.0;
     bool started_ = false;
     std::size_t checked_bodies_ = 0;
 };

@@ -3,6 +3,7 @@
 #include "core/errors.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -247,11 +248,25 @@ void World::prepare()
     }
 }
 
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point& mark)
+{
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - mark).count();
+    mark = now;
+    return s;
+}
+}  // namespace
+
 void World::evaluate_forces(double dt_s, double half_kick_s)
 {
+    auto mark = std::chrono::steady_clock::now();
     compute_pair_forces(dt_s);
+    phase_seconds_.pair_forces += seconds_since(mark);
     compute_wall_contacts(dt_s);
+    phase_seconds_.wall_forces += seconds_since(mark);
     gather_forces_and_kick(half_kick_s);
+    phase_seconds_.integration += seconds_since(mark);
 }
 
 void World::run_steps(std::uint64_t n)
@@ -269,6 +284,7 @@ void World::step()
     auto& v = particles_.velocity_m_per_s;
     auto& w = particles_.angular_velocity_rad_per_s;
 
+    auto mark = std::chrono::steady_clock::now();
     // first half kick with last step's forces, then drift (velocity Verlet); the largest move since the
     // last neighbour-list rebuild comes along
     const bool tracked = reference_position_m_.size() == n;
@@ -285,13 +301,18 @@ void World::step()
     // moving walls to the end of the step, their velocities at mid-step
     move_prescribed_meshes(time_s_ + dt, dt);
 
+    phase_seconds_.integration += seconds_since(mark);
+
     // neighbour lists, rebuilt when a particle or a wall has used up the skin
     if (rebuild_needed_ || !tracked || needs_rebuild(std::sqrt(max_move2))) rebuild();
+    phase_seconds_.neighbour_search += seconds_since(mark);
 
     // forces: sphere pairs into per-thread arrays, wall contacts per particle, then per particle the sum
     // and the second half kick
     evaluate_forces(dt, 0.5 * dt);
+    mark = std::chrono::steady_clock::now();
     finish_step(dt);
+    phase_seconds_.integration += seconds_since(mark);
 }
 
 void World::move_prescribed_meshes(double t_end_s, double dt_s)

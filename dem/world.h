@@ -35,6 +35,14 @@ struct WorldSettings {
 inline constexpr double kStableStepFactor = 0.2;
 inline constexpr double kDefaultStepFactor = 0.15;
 
+/// Wall-clock seconds spent in each phase of step(), summed since the world was made (benchmarks).
+struct PhaseSeconds {
+    double neighbour_search = 0.0;  ///< neighbour-list and wall-candidate rebuilds
+    double pair_forces = 0.0;       ///< sphere-sphere contacts
+    double wall_forces = 0.0;       ///< sphere-wall contacts: planes, meshes and coupled rigid bodies
+    double integration = 0.0;       ///< kicks, drift, force gathering, wall reactions and records
+};
+
 /// One touching sphere pair, for inspection and output.
 struct PairContactView {
     std::uint32_t id_a = 0, id_b = 0;  ///< stable particle ids
@@ -113,6 +121,7 @@ public:
     Vec3 angular_momentum_kg_m2_per_s() const;        ///< about the origin, including spin
     double total_mass_kg() const;
     int threads() const { return threads_; }
+    const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
 
 private:
     struct WallRef { bool is_mesh; int index; };
@@ -194,6 +203,7 @@ private:
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
     std::vector<ContactRecord> records_;
     double max_overlap_ratio_ = 0.0;
+    PhaseSeconds phase_seconds_;
 };
 
 }  // namespace dipper::dem

@@ -71,6 +71,12 @@ int RigidWorld::add_material(const std::string& name)
     return static_cast<int>(old);
 }
 
+const std::string& RigidWorld::material_name(int material) const
+{
+    impl_->check_material(material, "material_name");
+    return impl_->pairs.names[static_cast<std::size_t>(material)];
+}
+
 int RigidWorld::material_index(const std::string& name) const
 {
     const auto& m = impl_->pairs.names;

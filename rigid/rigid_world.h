@@ -54,6 +54,7 @@ public:
     // ---- materials: contact friction and restitution per pair (symmetric), no product rule
     int add_material(const std::string& name);
     int material_index(const std::string& name) const;
+    const std::string& material_name(int material) const;
     void set_pair(const std::string& a, const std::string& b, double friction, double restitution);
     double pair_friction(int a, int b) const;
     double pair_restitution(int a, int b) const;
