@@ -62,7 +62,12 @@ void MeshWall::set_pose(const Mat3& rotation, const Vec3& translation_m, const V
     vertices_world_.resize(body.size());
     for (std::size_t v = 0; v < body.size(); ++v) vertices_world_[v] = rotation * body[v] + translation_m;
     normals_world_.resize(mesh_.triangle_count());
-    for (std::size_t t = 0; t < mesh_.triangle_count(); ++t) normals_world_[t] = rotation * mesh_.triangle_normal(t);
+    packed_.resize(mesh_.triangle_count());
+    for (std::size_t t = 0; t < mesh_.triangle_count(); ++t) {
+        normals_world_[t] = rotation * mesh_.triangle_normal(t);
+        const auto& tri = mesh_.triangles()[t];
+        packed_[t] = {vertices_world_[tri[0]], vertices_world_[tri[1]], vertices_world_[tri[2]], normals_world_[t]};
+    }
 }
 
 }  // namespace dipper::dem

@@ -37,6 +37,11 @@ struct PrescribedMotion {
     Vec3 pivot_position_m(double t_s) const;
 };
 
+/// A triangle's world vertices and unit normal in one place, for the contact search's inner loop.
+struct PackedTriangle {
+    Vec3 a, b, c, normal;
+};
+
 /// A triangle mesh wall. The mesh is kept in its body frame; its world pose and velocity are set each
 /// step, either from a PrescribedMotion or from outside (the coupling module moves machine parts).
 class MeshWall {
@@ -56,6 +61,7 @@ public:
     const meshes::TriangleMesh& mesh() const { return mesh_; }
     const std::vector<Vec3>& vertices_world_m() const { return vertices_world_; }
     const Vec3& normal_world(std::size_t t) const { return normals_world_[t]; }
+    const PackedTriangle& packed(std::size_t t) const { return packed_[t]; }
     const Vec3& angular_velocity_rad_per_s() const { return angular_velocity_; }
     /// The point whose velocity set_pose gave (a rigid body's centre of mass), world frame.
     const Vec3& reference_point_m() const { return reference_point_; }
@@ -81,6 +87,7 @@ private:
     Vec3 reference_point_, reference_velocity_, angular_velocity_;
     std::vector<Vec3> vertices_world_;
     std::vector<Vec3> normals_world_;
+    std::vector<PackedTriangle> packed_;
     std::uint64_t pose_version_ = 0;
     double mass_kg_ = 0.0;
 };

@@ -617,10 +617,10 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
                 }
             for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1]; ++k) {
                 const MeshCandidate mc = bucket[k];
-                const auto& verts = meshes_[mc.mesh].vertices_world_m();
-                const auto& tri = meshes_[mc.mesh].mesh().triangles()[mc.triangle];
-                if (meshes::closest_point_on_triangle(p, verts[tri[0]], verts[tri[1]], verts[tri[2]]).distance_squared <
-                    range * range) {
+                const PackedTriangle& pt = meshes_[mc.mesh].packed(mc.triangle);
+                const double plane_distance = dot(p - pt.a, pt.normal);
+                if (plane_distance >= range || plane_distance <= -range) continue;
+                if (meshes::closest_point_on_triangle(p, pt.a, pt.b, pt.c).distance_squared < range * range) {
                     out.push_back(mc);
                     ++counts[i];
                 }
@@ -742,12 +742,19 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
     for (; k < last; ++k) {
         const MeshCandidate mc = candidates_[k];
         const MeshWall& mw = meshes_[mc.mesh];
-        const auto& tri = mw.mesh().triangles()[mc.triangle];
-        const auto& verts = mw.vertices_world_m();
-        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(x, verts[tri[0]], verts[tri[1]], verts[tri[2]]);
+        const PackedTriangle& pt = mw.packed(mc.triangle);
+        if (k + 2 < last) {  // the triangles are scattered over many meshes: ask for the one after next early
+            const MeshCandidate ahead = candidates_[k + 2];
+            __builtin_prefetch(&meshes_[ahead.mesh].packed(ahead.triangle));
+        }
+        // a triangle whose plane is r or more away cannot be touched: one dot product spares the closest point
+        const double plane_distance = dot(x - pt.a, pt.normal);
+        if (plane_distance >= r || plane_distance <= -r) continue;
+        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(x, pt.a, pt.b, pt.c);
         if (cp.distance_squared >= r * r) continue;
+        const auto& tri = mw.mesh().triangles()[mc.triangle];
         const double dist = std::sqrt(cp.distance_squared);
-        Vec3 normal = dist > 1e-12 * r ? (x - cp.point) * (1.0 / dist) : mw.normal_world(mc.triangle);
+        Vec3 normal = dist > 1e-12 * r ? (x - cp.point) * (1.0 / dist) : pt.normal;
         std::uint32_t feature_id = mc.triangle;
         if (cp.feature == meshes::Feature::Edge) feature_id = mw.mesh().triangle_edges(mc.triangle)[static_cast<std::size_t>(cp.local_index)];
         if (cp.feature == meshes::Feature::Vertex) feature_id = tri[static_cast<std::size_t>(cp.local_index)];
