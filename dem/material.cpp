@@ -94,12 +94,12 @@ const PairCoefficients& MaterialTable::pair(MaterialIndex a, MaterialIndex b) co
     return pairs_[a * materials_.size() + b];
 }
 
-MaterialTable MaterialTable::aitik_copper_ore()
+MaterialTable MaterialTable::aitik_copper_ore(double particle_density_kg_per_m3)
 {
     MaterialTable t;
     // Table 2, "for all rocks": rho 3700 kg/m3 (to be scaled to bulk density 1903 kg/m3), E 45 GPa, nu 0.3
-    t.add({"ore", 3700.0, 45e9, 0.3, false});
-    t.add({"rock", 3700.0, 45e9, 0.3, false});
+    t.add({"ore", particle_density_kg_per_m3, 45e9, 0.3, false});
+    t.add({"rock", particle_density_kg_per_m3, 45e9, 0.3, false});
     t.add({"ground", 0.0, 0.0, 0.0, true});
     t.add({"bucket", 0.0, 0.0, 0.0, true});
     t.add({"truck", 0.0, 0.0, 0.0, true});

@@ -62,7 +62,9 @@ public:
     /// seen by spheres), surfaces "ground", "bucket", "truck", and "steel" (any other machine surface,
     /// Table 2's "DE-remaining", frictionless). Where Table 2 is silent the thesis says damping 1 and
     /// stiffness scale 0.05; spheres against rocks take DE-DE rolling friction.
-    static MaterialTable aitik_copper_ore();
+    /// `particle_density_kg_per_m3` replaces Table 2's 3700 for "ore" and "rock" alike (the thesis scales it
+    /// to hit the bulk density 1903 kg/m3; coupling/bulk_density.h finds the scaled value).
+    static MaterialTable aitik_copper_ore(double particle_density_kg_per_m3 = 3700.0);
 
 private:
     void check_index(MaterialIndex i, const std::string& where) const;
