@@ -64,10 +64,7 @@ BulkDensityResult measure_bulk_density(const BulkDensityBox& box, double particl
     ds.threads = box.threads;
     dem::World dem(dem::MaterialTable::aitik_copper_ore(particle_density), ds);
     rigid::RigidWorld rigid;
-    rigid.add_material("rock");
-    rigid.add_material("ground");
-    rigid.set_pair("rock", "rock", 0.85, 0.2);   // Table 2: FE-FE mu 0.85
-    rigid.set_pair("rock", "ground", 0.9, 0.2);  // FE-ground mu 0.9
+    rigid::add_aitik_copper_ore_materials(rigid);
     CoupledWorld world(dem, rigid, CouplingSettings{box.substeps});
 
     // the loose fill needs room above the box: a container as tall as the fill, struck off at height_m later

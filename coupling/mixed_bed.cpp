@@ -197,12 +197,10 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
                 Vec3 ext_lo{1e300, 1e300, 1e300}, ext_hi{-1e300, -1e300, -1e300};
                 for (const Vec3& v : shape.vertices_m()) {
                     const Vec3 w = r * v;
-                    for (int a = 0; a < 3; ++a) {
-                        ext_lo = {std::min(ext_lo.x, w.x), std::min(ext_lo.y, w.y), std::min(ext_lo.z, w.z)};
-                        ext_hi = {std::max(ext_hi.x, w.x), std::max(ext_hi.y, w.y), std::max(ext_hi.z, w.z)};
-                    }
+                    ext_lo = {std::min(ext_lo.x, w.x), std::min(ext_lo.y, w.y), std::min(ext_lo.z, w.z)};
+                    ext_hi = {std::max(ext_hi.x, w.x), std::max(ext_hi.y, w.y), std::max(ext_hi.z, w.z)};
                 }
-                Vec3 c_min = lo - ext_lo, c_max = hi - ext_hi;
+                const Vec3 c_min = lo - ext_lo, c_max = hi - ext_hi;
                 if (c_min.x > c_max.x || c_min.y > c_max.y || c_min.z > c_max.z) continue;
                 const Vec3 centre{c_min.x + u(rng) * (c_max.x - c_min.x), c_min.y + u(rng) * (c_max.y - c_min.y),
                                   c_min.z + u(rng) * (c_max.z - c_min.z)};

@@ -152,4 +152,9 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+/// Rock materials of the Aitik copper ore (thesis Paper A Table 2) as Bullet sees them: "rock", "ground",
+/// "bucket"; friction rock-rock 0.85, rock-ground 0.9, rock-bucket 0.53 (the Hardox pin-on-disc value).
+/// Table 2 gives no restitution; where it is silent the thesis damps fully, so restitution is 0.
+void add_aitik_copper_ore_materials(RigidWorld& world);
+
 }  // namespace dipper::rigid

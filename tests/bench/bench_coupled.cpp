@@ -43,10 +43,7 @@ struct Bed {
           }()),
           world(dem, rigid, coupling::CouplingSettings{substeps})
     {
-        rigid.add_material("rock");
-        rigid.add_material("ground");
-        rigid.set_pair("rock", "rock", 0.85, 0.2);
-        rigid.set_pair("rock", "ground", 0.9, 0.2);
+        rigid::add_aitik_copper_ore_materials(rigid);
     }
     /// Floor and sides in both worlds: DEM planes (ground floor, frictionless steel sides) and, for the rocks,
     /// Bullet's ground plane and a fixed open box.
@@ -163,9 +160,8 @@ int main(int argc, char** argv)
         const double per = 1.0 / sim;
         if (n == 0) dem_only_total = wall * per;
         std::size_t body_contacts = 0;
-        for (std::size_t k = 0; k < bed.dem.last_contact_records().size(); ++k)
-            if (!bed.dem.is_mesh(bed.dem.last_contact_records()[k].surface_id)) continue;
-            else ++body_contacts;
+        for (const ContactRecord& r : bed.dem.last_contact_records())
+            if (bed.dem.is_mesh(r.surface_id)) ++body_contacts;
         std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f | %zu | %zu |\n",
                     n == 0 ? "DEM only" : ("n = " + std::to_string(n)).c_str(), wall * per, (p.pair_forces - p0.pair_forces) * per,
                     (p.wall_forces - p0.wall_forces) * per, (p.neighbour_search - p0.neighbour_search) * per,

@@ -9,18 +9,6 @@
 
 namespace dipper::test {
 
-/// Rigid materials of thesis Table 2 as Bullet sees them: rock-rock and rock-ground mu 0.85 and 0.9,
-/// rock-bucket 0.53; restitution 0.2 (Bullet's impulse solver needs one; rocks barely bounce).
-inline void add_rigid_table2(rigid::RigidWorld& w)
-{
-    w.add_material("rock");
-    w.add_material("ground");
-    w.add_material("bucket");
-    w.set_pair("rock", "rock", 0.85, 0.2);
-    w.set_pair("rock", "ground", 0.9, 0.2);
-    w.set_pair("rock", "bucket", 0.53, 0.2);
-}
-
 struct CoupledScene {
     dem::World dem;
     rigid::RigidWorld rigid;
@@ -29,7 +17,7 @@ struct CoupledScene {
     CoupledScene(dem::MaterialTable table, dem::WorldSettings ds, rigid::RigidSettings rs, int substeps)
         : dem(std::move(table), ds), rigid(rs), world(dem, rigid, coupling::CouplingSettings{substeps})
     {
-        add_rigid_table2(rigid);
+        rigid::add_aitik_copper_ore_materials(rigid);
     }
 };
 
