@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <unordered_map>
 
 namespace dipper::dem {
@@ -233,6 +234,32 @@ std::size_t Pourer::update(World& world)
         ++added;
     }
     return added;
+}
+
+void Pourer::write_state(StateWriter& out) const
+{
+    out.tag("pourer");
+    out.array(radii_);
+    out.value<std::uint64_t>(next_);
+    out.value(poured_mass_kg_);
+    out.value(start_time_s_);
+    std::ostringstream random;
+    random << random_;
+    out.text(random.str());
+}
+
+void Pourer::read_state(StateReader& in)
+{
+    in.tag("pourer");
+    in.array(radii_);
+    const auto next = in.value<std::uint64_t>();
+    if (next > radii_.size()) in.fail("a pour further along than it has particles");
+    next_ = static_cast<std::size_t>(next);
+    poured_mass_kg_ = in.value<double>();
+    start_time_s_ = in.value<double>();
+    std::istringstream random(in.text());
+    random >> random_;
+    if (!random) in.fail("an unreadable random state");
 }
 
 }  // namespace dipper::dem

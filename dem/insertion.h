@@ -89,6 +89,9 @@ public:
     std::size_t update(World& world);
     bool done() const { return start_time_s_ >= 0.0 && next_ >= radii_.size(); }
     double poured_mass_kg() const { return poured_mass_kg_; }
+    /// Progress and random state, for checkpoints (the region and sizes come from the same input again).
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
 
 private:
     BoxRegion region_;

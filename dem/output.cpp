@@ -67,6 +67,17 @@ void write_mesh_vtp(const MeshWall& wall, const std::string& path)
 void PvdCollection::add(double time_s, const std::string& file)
 {
     entries_.emplace_back(time_s, file);
+    rewrite();
+}
+
+void PvdCollection::restore(std::vector<std::pair<double, std::string>> entries)
+{
+    entries_ = std::move(entries);
+    rewrite();
+}
+
+void PvdCollection::rewrite() const
+{
     const std::string tmp = path_ + ".tmp";
     {
         std::ofstream out = open_for_writing(tmp);

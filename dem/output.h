@@ -23,8 +23,12 @@ public:
     explicit PvdCollection(std::string path) : path_(std::move(path)) {}
     /// Records that `file` (relative to the .pvd's folder) holds the state at time_s.
     void add(double time_s, const std::string& file);
+    /// The entries so far, and setting them back (a resumed run drops what came after its checkpoint).
+    const std::vector<std::pair<double, std::string>>& entries() const { return entries_; }
+    void restore(std::vector<std::pair<double, std::string>> entries);
 
 private:
+    void rewrite() const;
     std::string path_;
     std::vector<std::pair<double, std::string>> entries_;
 };

@@ -72,4 +72,32 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order)
     apply_order(id, order, si);
 }
 
+void ParticleStore::write_state(StateWriter& out) const
+{
+    out.tag("particles");
+    for (const auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m}) out.array(*v);
+    for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) out.array(*v);
+    out.array(material);
+    out.array(id);
+    out.value(next_id_);
+}
+
+void ParticleStore::read_state(StateReader& in, const MaterialTable& materials)
+{
+    in.tag("particles");
+    for (auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m}) in.array(*v);
+    for (auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) in.array(*v);
+    in.array(material);
+    in.array(id);
+    next_id_ = in.value<std::uint32_t>();
+    const std::size_t n = position_m.size();
+    for (const auto* v : {&velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m})
+        if (v->size() != n) in.fail("particle arrays of different lengths");
+    for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2})
+        if (v->size() != n) in.fail("particle arrays of different lengths");
+    if (material.size() != n || id.size() != n) in.fail("particle arrays of different lengths");
+    for (MaterialIndex m : material)
+        if (m >= materials.size()) in.fail(concat("particle material ", m, " beyond the ", materials.size(), " materials"));
+}
+
 }  // namespace dipper::dem

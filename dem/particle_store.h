@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/vec3.h"
+#include "core/state_io.h"
 #include "dem/material.h"
 
 #include <cstdint>
@@ -33,6 +34,10 @@ public:
 
     /// Reorders every array so that new index k holds what old index order[k] held.
     void permute(const std::vector<std::uint32_t>& order);
+
+    /// Every array and the next id, for checkpoints; read_state replaces the whole store.
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in, const MaterialTable& materials);
 
     // hot: read or written every step
     std::vector<Vec3> position_m, velocity_m_per_s, angular_velocity_rad_per_s;

@@ -70,4 +70,12 @@ void MeshWall::set_pose(const Mat3& rotation, const Vec3& translation_m, const V
     }
 }
 
+void MeshWall::restore_pose(const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_world_m,
+                            const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s,
+                            std::uint64_t pose_version)
+{
+    set_pose(rotation, translation_m, reference_point_world_m, reference_velocity_m_per_s, angular_velocity_rad_per_s);
+    pose_version_ = pose_version;
+}
+
 }  // namespace dipper::dem

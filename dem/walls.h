@@ -76,6 +76,11 @@ public:
     const Vec3& translation_m() const { return translation_; }
     /// Counts pose changes, so that neighbour lists notice a wall moved from outside.
     std::uint64_t pose_version() const { return pose_version_; }
+    /// Sets a saved pose and pose count back (checkpoints).
+    void restore_pose(const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_world_m,
+                      const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s,
+                      std::uint64_t pose_version);
+    const Vec3& reference_velocity_m_per_s() const { return reference_velocity_; }
 
 private:
     meshes::TriangleMesh mesh_;

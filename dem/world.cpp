@@ -1006,3 +1006,139 @@ double World::total_mass_kg() const
 }
 
 }  // namespace dipper::dem
+
+// ---- checkpoints ---------------------------------------------------------------------------------
+
+namespace dipper::dem {
+
+void World::write_state(StateWriter& out) const
+{
+    out.tag("dem-world");
+    out.value<std::uint64_t>(materials_.size());
+    for (std::size_t m = 0; m < materials_.size(); ++m) out.text(materials_.material(static_cast<MaterialIndex>(m)).name);
+    out.value<std::uint64_t>(walls_.size());
+    for (std::size_t w = 0; w < walls_.size(); ++w) out.text(wall_name(static_cast<int>(w)));
+    particles_.write_state(out);
+    out.value(time_s_);
+    out.value(step_s_);
+    out.value(step_count_);
+    out.value(rebuild_count_);
+    out.value<std::uint8_t>(prepared_);
+    out.value<std::uint8_t>(rebuild_needed_);
+    out.value<std::uint8_t>(step_checked_);
+    out.tag("mesh-poses");
+    for (const MeshWall& m : meshes_) {
+        out.value(m.rotation());
+        out.value(m.translation_m());
+        out.value(m.reference_point_m());
+        out.value(m.reference_velocity_m_per_s());
+        out.value(m.angular_velocity_rad_per_s());
+        out.value(m.pose_version());
+        out.value(m.mass_kg());
+    }
+    out.tag("neighbours");
+    out.array(pair_i_);
+    out.array(pair_j_);
+    out.array(pair_history_);
+    out.array(pair_touching_);
+    out.array(reference_position_m_);
+    out.array(stiffness_radius_N_per_m_);
+    out.value<std::uint64_t>(reference_mesh_vertices_m_.size());
+    for (const auto& v : reference_mesh_vertices_m_) out.array(v);
+    out.array(reference_mesh_version_);
+    out.value(skin_m_);
+    out.tag("wall-contacts");
+    out.array(wall_contacts_);
+    out.array(wall_contact_start_);
+    out.array(candidate_start_);
+    out.array(candidates_);
+    out.array(wall_force_N_);
+    out.array(wall_torque_N_m_);
+    out.value(max_overlap_ratio_);
+}
+
+void World::read_state(StateReader& in)
+{
+    in.tag("dem-world");
+    const auto material_count = in.value<std::uint64_t>();
+    if (material_count != materials_.size())
+        in.fail(concat("the state has ", material_count, " materials, this world ", materials_.size()));
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+        const std::string name = in.text();
+        if (name != materials_.material(static_cast<MaterialIndex>(m)).name)
+            in.fail(concat("material ", m, " is '", name, "' in the state, '", materials_.material(static_cast<MaterialIndex>(m)).name,
+                           "' in this world"));
+    }
+    const auto wall_count = in.value<std::uint64_t>();
+    if (wall_count != walls_.size()) in.fail(concat("the state has ", wall_count, " walls, this world ", walls_.size()));
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        const std::string name = in.text();
+        if (name != wall_name(static_cast<int>(w)))
+            in.fail(concat("wall ", w, " is '", name, "' in the state, '", wall_name(static_cast<int>(w)), "' in this world"));
+    }
+    particles_.read_state(in, materials_);
+    time_s_ = in.value<double>();
+    step_s_ = in.value<double>();
+    step_count_ = in.value<std::uint64_t>();
+    rebuild_count_ = in.value<std::uint64_t>();
+    prepared_ = in.value<std::uint8_t>() != 0;
+    rebuild_needed_ = in.value<std::uint8_t>() != 0;
+    step_checked_ = in.value<std::uint8_t>() != 0;
+    in.tag("mesh-poses");
+    for (MeshWall& m : meshes_) {
+        const auto rotation = in.value<Mat3>();
+        const auto translation = in.value<Vec3>();
+        const auto reference = in.value<Vec3>();
+        const auto velocity = in.value<Vec3>();
+        const auto spin = in.value<Vec3>();
+        const auto version = in.value<std::uint64_t>();
+        m.restore_pose(rotation, translation, reference, velocity, spin, version);
+        m.set_mass_kg(in.value<double>());
+    }
+    in.tag("neighbours");
+    in.array(pair_i_);
+    in.array(pair_j_);
+    in.array(pair_history_);
+    in.array(pair_touching_);
+    in.array(reference_position_m_);
+    in.array(stiffness_radius_N_per_m_);
+    const auto reference_meshes = in.value<std::uint64_t>();
+    if (reference_meshes > meshes_.size()) in.fail("more mesh references than meshes");
+    reference_mesh_vertices_m_.resize(static_cast<std::size_t>(reference_meshes));
+    for (auto& v : reference_mesh_vertices_m_) in.array(v);
+    in.array(reference_mesh_version_);
+    skin_m_ = in.value<double>();
+    in.tag("wall-contacts");
+    in.array(wall_contacts_);
+    in.array(wall_contact_start_);
+    in.array(candidate_start_);
+    in.array(candidates_);
+    in.array(wall_force_N_);
+    in.array(wall_torque_N_m_);
+    max_overlap_ratio_ = in.value<double>();
+
+    // indices must stay inside the arrays they index (a corrupt file must not crash the run)
+    const std::size_t n = particles_.size();
+    if (pair_j_.size() != pair_i_.size() || pair_history_.size() != pair_i_.size() || pair_touching_.size() != pair_i_.size())
+        in.fail("neighbour arrays of different lengths");
+    for (std::size_t k = 0; k < pair_i_.size(); ++k)
+        if (pair_i_[k] >= n || pair_j_[k] >= n) in.fail("a neighbour pair names a particle that does not exist");
+    if (prepared_ && (reference_position_m_.size() != n || stiffness_radius_N_per_m_.size() != n))
+        in.fail("reference arrays do not match the particle count");
+    for (const WallContact& c : wall_contacts_)
+        if (c.particle >= n || c.wall < 0 || static_cast<std::size_t>(c.wall) >= walls_.size()) in.fail("a wall contact out of range");
+    if (prepared_ && (wall_contact_start_.size() != n + 1 || candidate_start_.size() != n + 1))
+        in.fail("contact index arrays do not match the particle count");
+    if (!wall_contact_start_.empty() && wall_contact_start_.back() != wall_contacts_.size()) in.fail("wall contact index mismatch");
+    if (!candidate_start_.empty() && candidate_start_.back() != candidates_.size()) in.fail("wall candidate index mismatch");
+    for (const MeshCandidate& c : candidates_) {
+        if (c.triangle == kPlaneCandidate ? c.mesh >= planes_.size() : (c.mesh >= meshes_.size() || c.triangle >= meshes_[c.mesh].mesh().triangle_count()))
+            in.fail("a wall candidate out of range");
+    }
+    if (reference_mesh_version_.size() != reference_mesh_vertices_m_.size()) in.fail("mesh reference arrays differ in length");
+    if (wall_force_N_.size() != walls_.size() || wall_torque_N_m_.size() != walls_.size())
+        wall_force_N_.assign(walls_.size(), Vec3{}), wall_torque_N_m_.assign(walls_.size(), Vec3{});
+    records_.clear();
+}
+
+}  // namespace dipper::dem

@@ -80,6 +80,15 @@ public:
     /// Makes the next step rebuild the neighbour lists (history is carried over as always).
     void request_rebuild() { rebuild_needed_ = true; }
 
+    // ---- checkpoints ---------------------------------------------------------------------------
+    /// Writes the complete dynamic state: particles, forces, contact history, neighbour and wall-candidate
+    /// lists, wall poses, time and counters. read_state on a world built the same way (same materials and
+    /// walls, in the same order) then continues bit for bit as this world would have.
+    void write_state(StateWriter& out) const;
+    /// Replaces the particles and the dynamic state by a saved one. The walls and materials are checked
+    /// against the saved names; the file is refused with an InputError if they differ.
+    void read_state(StateReader& in);
+
     // ---- time step -----------------------------------------------------------------------------
     /// sqrt(m_i / K_max,i) minimised over particles, K_max,i the stiffest contact particle i can have.
     double reference_step_s() const;

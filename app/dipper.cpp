@@ -1,0 +1,149 @@
+// dipper: runs scenario files.
+//
+//   dipper run FILE [--out DIR] [--threads N] [--stop-after S] [--quiet]
+//   dipper check FILE...
+//   dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]
+//   dipper keys            (every scenario key as a Markdown table)
+#include "core/errors.h"
+#include "scenario/keys.h"
+#include "scenario/runner.h"
+#include "scenario/scenario.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace dipper;
+using namespace dipper::scenario;
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: dipper run FILE [--out DIR] [--threads N] [--stop-after SECONDS] [--quiet]\n"
+    "       dipper check FILE...\n"
+    "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
+    "       dipper keys\n";
+
+[[noreturn]] void usage(const std::string& message)
+{
+    std::fprintf(stderr, "dipper: %s\n%s", message.c_str(), kUsage);
+    std::exit(2);
+}
+
+struct Options {
+    std::vector<std::string> positional;
+    std::string out, from;
+    RunOptions run;
+};
+
+Options parse_options(int argc, char** argv, int first)
+{
+    Options o;
+    for (int a = first; a < argc; ++a) {
+        const std::string arg = argv[a];
+        const auto value = [&]() -> std::string {
+            if (a + 1 >= argc) usage(arg + " needs a value");
+            return argv[++a];
+        };
+        if (arg == "--out") o.out = value();
+        else if (arg == "--from") o.from = value();
+        else if (arg == "--threads") {
+            const std::string v = value();
+            char* end = nullptr;
+            const long n = std::strtol(v.c_str(), &end, 10);
+            if (v.empty() || *end != '\0' || n < 1 || n > 1024) usage("--threads needs a whole number from 1 to 1024; got '" + v + "'");
+            o.run.threads = static_cast<int>(n);
+        } else if (arg == "--stop-after") {
+            const std::string v = value();
+            char* end = nullptr;
+            o.run.stop_after_s = std::strtod(v.c_str(), &end);
+            if (v.empty() || *end != '\0' || !(o.run.stop_after_s > 0.0)) usage("--stop-after needs seconds > 0; got '" + v + "'");
+        } else if (arg == "--quiet") o.run.progress = false;
+        else if (!arg.empty() && arg[0] == '-') usage("unknown option " + arg);
+        else o.positional.push_back(arg);
+    }
+    return o;
+}
+
+/// What a finished run prints: status, the summary's main numbers, and where the files are.
+void report(const RunResult& result, const std::string& dir)
+{
+    std::ifstream in(dir + "/summary.json");
+    std::stringstream text;
+    text << in.rdbuf();
+    const char* status = result.status == RunStatus::completed ? "completed"
+                         : result.status == RunStatus::interrupted ? "interrupted" : "DIVERGED";
+    std::printf("dipper: run %s at t = %.6g s after %llu steps\n", status, result.time_s,
+                static_cast<unsigned long long>(result.steps));
+    if (!result.message.empty()) std::printf("  %s\n", result.message.c_str());
+    std::printf("summary (%s/summary.json):\n%s", dir.c_str(), text.str().c_str());
+    std::printf("files: %s/particles.pvd (ParaView), %s/probes.csv, %s/checkpoint.bin\n", dir.c_str(), dir.c_str(), dir.c_str());
+    if (result.status == RunStatus::interrupted) std::printf("continue with: dipper resume %s\n", dir.c_str());
+    if (result.status == RunStatus::diverged)
+        std::printf("the files written up to the failure are kept in %s; the last checkpoint (if any) can be resumed after "
+                    "changing nothing, or the scenario rerun with a smaller time.step_s\n", dir.c_str());
+}
+
+int print_keys()
+{
+    std::printf("| key | type | default | meaning |\n| --- | --- | --- | --- |\n");
+    for (const KeySpec& k : scenario_keys())
+        std::printf("| `%s` | %s | %s | %s |\n", k.path.c_str(), k.type.c_str(),
+                    k.default_value.empty() ? "" : ("`" + k.default_value + "`").c_str(), k.description.c_str());
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    if (argc < 2) usage("no command given");
+    const std::string command = argv[1];
+    if (command == "--help" || command == "-h" || command == "help") {
+        std::printf("%s", kUsage);
+        return 0;
+    }
+    try {
+        if (command == "keys") return print_keys();
+        const Options o = parse_options(argc, argv, 2);
+        if (command == "check") {
+            if (o.positional.empty()) usage("check needs at least one scenario file");
+            for (const std::string& file : o.positional) {
+                const Scenario s = load_scenario(file);
+                const auto world = build_world(s);  // mesh files are read and checked too
+                check_pairs(s, *world);
+                double fill = 0.0, pour = 0.0;
+                for (const auto& f : s.fills) fill += f.mass_kg;
+                for (const auto& p : s.pours) pour += p.mass_kg;
+                std::printf("%s: ok: '%s', %.6g s, %zu walls, %.6g kg filled, %.6g kg poured, %zu materials\n", file.c_str(),
+                            s.name.c_str(), s.duration_s, world->wall_count(), fill, pour, s.materials.size());
+            }
+            return 0;
+        }
+        if (command == "run") {
+            if (o.positional.size() != 1) usage("run needs exactly one scenario file");
+            const Scenario s = load_scenario(o.positional[0]);
+            const std::string dir = o.out.empty() ? "out/" + s.name : o.out;
+            const RunResult r = run_scenario(s, dir, o.run);
+            report(r, dir);
+            return exit_code(r);
+        }
+        if (command == "resume") {
+            if (o.positional.size() != 1) usage("resume needs exactly one output folder");
+            const RunResult r = resume_run(o.positional[0], o.run, o.from);
+            report(r, o.positional[0]);
+            return exit_code(r);
+        }
+        usage("unknown command '" + command + "'");
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "dipper: %s\n", e.what());
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "dipper: %s\n", e.what());
+        return 1;
+    }
+}

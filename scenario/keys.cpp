@@ -1,0 +1,116 @@
+#include "scenario/keys.h"
+
+namespace dipper::scenario {
+
+const std::vector<KeySpec>& scenario_keys()
+{
+    static const std::vector<KeySpec> keys = {
+        {"dipper_scenario", "integer", "required", "format version of the file; 1"},
+        {"name", "string", "none", "name of the run in reports; the file name without extension if absent"},
+        {"seed", "integer", "1", "seed of every random choice (fills, pours); same seed, same run"},
+        {"threads", "integer", "0", "OpenMP threads; 0 takes OMP_NUM_THREADS or all cores"},
+        {"gravity_m_per_s2", "vector3", "[0, 0, -9.81]", "gravitational acceleration"},
+
+        {"time", "map", "required", "time stepping"},
+        {"time.duration_s", "number", "required", "simulated time to run, from 0"},
+        {"time.step_s", "number", "0", "DEM time step; 0 takes 0.15 sqrt(m/K) of the smallest, stiffest particle, "
+                                      "a value above the stable limit 0.2 sqrt(m/K) is refused"},
+
+        {"materials", "map", "{}", "materials and pair coefficients (thesis Paper A Table 2)"},
+        {"materials.preset", "string", "aitik_copper_ore",
+         "starting table: aitik_copper_ore (materials ore, rock, ground, bucket, truck, steel and their pairs) or none"},
+        {"materials.particle_density_kg_per_m3", "number", "3700",
+         "density of the preset's ore and rock (the bulk-density calibration scales it)"},
+        {"materials.add", "list", "[]", "materials added to the preset"},
+        {"materials.add[].name", "string", "required", "unique material name"},
+        {"materials.add[].surface", "boolean", "false", "true for a wall material (infinitely stiff and massive)"},
+        {"materials.add[].density_kg_per_m3", "number", "required", "particle density (ignored for a surface)"},
+        {"materials.add[].youngs_modulus_Pa", "number", "required", "Young's modulus E (eq. 5)"},
+        {"materials.add[].poisson_ratio", "number", "required", "Poisson's ratio, 0 to 0.5 (eq. 5)"},
+        {"materials.pairs", "list", "[]", "pair coefficients set or changed; a key left out keeps the pair's value "
+                                         "(or the default of a new pair)"},
+        {"materials.pairs[].materials", "list", "required", "the two material names, [a, b]"},
+        {"materials.pairs[].normal_stiffness_scale", "number", "0.05", "C_norm of eq. 4"},
+        {"materials.pairs[].tangential_stiffness_scale", "number", "0.27", "C_tan: Kt = C_tan Kn"},
+        {"materials.pairs[].friction", "number", "0", "Coulomb friction mu (eq. 7)"},
+        {"materials.pairs[].rolling_friction", "number", "0", "rolling friction mu_roll (eq. 8)"},
+        {"materials.pairs[].normal_damping_ratio", "number", "1", "D_n, fraction of critical damping (eq. 6)"},
+        {"materials.pairs[].tangential_damping_ratio", "number", "1", "D_t, fraction of critical damping"},
+
+        {"planes", "list", "[]", "infinite static walls"},
+        {"planes[].name", "string", "required", "unique wall name (used in outputs)"},
+        {"planes[].point_m", "vector3", "required", "a point on the plane"},
+        {"planes[].normal", "vector3", "required", "towards the side the particles are on; normalised"},
+        {"planes[].material", "string", "required", "surface material"},
+
+        {"meshes", "list", "[]", "triangle-mesh walls from files (STL, OBJ, PLY)"},
+        {"meshes[].name", "string", "required", "unique wall name (used in outputs)"},
+        {"meshes[].file", "string", "required", "mesh file, relative to the scenario file's folder"},
+        {"meshes[].material", "string", "required", "surface material"},
+        {"meshes[].scale", "number", "1", "factor from file units to metres (0.001 for millimetres)"},
+        {"meshes[].translate_m", "vector3", "[0, 0, 0]", "added to every vertex after scaling"},
+        {"meshes[].motion", "map", "none", "prescribed rigid motion; without it the mesh stays put"},
+        {"meshes[].motion.velocity_m_per_s", "vector3", "[0, 0, 0]", "constant velocity of the pivot"},
+        {"meshes[].motion.angular_velocity_rad_per_s", "vector3", "[0, 0, 0]", "constant angular velocity about the pivot"},
+        {"meshes[].motion.pivot_m", "vector3", "[0, 0, 0]", "the point that moves and that the mesh turns about, at t = 0"},
+        {"meshes[].motion.oscillation_amplitude_m", "vector3", "[0, 0, 0]", "A in pivot + v t + A sin(2 pi f t)"},
+        {"meshes[].motion.oscillation_frequency_Hz", "number", "0", "f of the oscillation"},
+
+        {"fills", "list", "[]", "particles placed at t = 0, seeded random and non-overlapping"},
+        {"fills[].material", "string", "ore", "particle material"},
+        {"fills[].mass_kg", "number", "required", "total mass to place"},
+        {"fills[].box", "map", "required", "the region: an axis-aligned box a whole sphere must fit in"},
+        {"fills[].box.min_m", "vector3", "required", "lower corner"},
+        {"fills[].box.max_m", "vector3", "required", "upper corner"},
+        {"fills[].sizes", "list", "required", "size classes by mass fraction (sum 1)"},
+        {"fills[].sizes[].radius_m", "number", "required", "sphere radius"},
+        {"fills[].sizes[].mass_fraction", "number", "required", "fraction of the mass"},
+
+        {"pours", "list", "[]", "particles entering from a box at a mass flow rate, from t = 0"},
+        {"pours[].material", "string", "ore", "particle material"},
+        {"pours[].mass_kg", "number", "required", "total mass to pour"},
+        {"pours[].rate_kg_per_s", "number", "required", "mass flow rate"},
+        {"pours[].velocity_m_per_s", "vector3", "[0, 0, 0]", "velocity of entering particles"},
+        {"pours[].box", "map", "required", "where particles enter"},
+        {"pours[].box.min_m", "vector3", "required", "lower corner"},
+        {"pours[].box.max_m", "vector3", "required", "upper corner"},
+        {"pours[].sizes", "list", "required", "size classes by mass fraction (sum 1)"},
+        {"pours[].sizes[].radius_m", "number", "required", "sphere radius"},
+        {"pours[].sizes[].mass_fraction", "number", "required", "fraction of the mass"},
+
+        {"probes", "map", "{}", "quantities written to probes.csv besides the standard columns"},
+        {"probes.regions", "list", "[]", "boxes whose particle mass is recorded (particles by centre)"},
+        {"probes.regions[].name", "string", "required", "column name stem: <name>_mass_kg"},
+        {"probes.regions[].min_m", "vector3", "required", "lower corner"},
+        {"probes.regions[].max_m", "vector3", "required", "upper corner"},
+
+        {"output", "map", "{}", "what is written, and how often"},
+        {"output.vtk_interval_s", "number", "0.1", "simulated seconds between ParaView snapshots; 0: first and last only"},
+        {"output.csv_interval_s", "number", "0.01", "simulated seconds between probes.csv rows"},
+        {"output.checkpoint_interval_s", "number", "0",
+         "simulated seconds between checkpoints; 0: only on SIGINT/SIGTERM and at the end"},
+        {"output.progress_interval_s", "number", "10", "wall-clock seconds between progress lines when not on a terminal"},
+    };
+    return keys;
+}
+
+const KeySpec* find_key(const std::string& path)
+{
+    for (const KeySpec& k : scenario_keys())
+        if (k.path == path) return &k;
+    return nullptr;
+}
+
+std::vector<std::string> child_keys(const std::string& path)
+{
+    std::vector<std::string> names;
+    const std::string prefix = path.empty() ? "" : path + ".";
+    for (const KeySpec& k : scenario_keys()) {
+        if (k.path.compare(0, prefix.size(), prefix) != 0) continue;
+        const std::string rest = k.path.substr(prefix.size());
+        if (!rest.empty() && rest.find('.') == std::string::npos) names.push_back(rest);
+    }
+    return names;
+}
+
+}  // namespace dipper::scenario

@@ -1,0 +1,460 @@
+#include "scenario/runner.h"
+
+#include "core/errors.h"
+#include "core/files.h"
+#include "core/state_io.h"
+#include "dem/output.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <unistd.h>
+
+namespace dipper::scenario {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 1";
+
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void on_signal(int signal) { g_signal = signal; }
+
+/// Catches SIGINT and SIGTERM for the life of a run, so that the loop can checkpoint and stop.
+class SignalGuard {
+public:
+    SignalGuard()
+    {
+        g_signal = 0;
+        struct sigaction action {};
+        action.sa_handler = on_signal;
+        sigemptyset(&action.sa_mask);
+        sigaction(SIGINT, &action, &old_int_);
+        sigaction(SIGTERM, &action, &old_term_);
+    }
+    ~SignalGuard()
+    {
+        sigaction(SIGINT, &old_int_, nullptr);
+        sigaction(SIGTERM, &old_term_, nullptr);
+    }
+    SignalGuard(const SignalGuard&) = delete;
+    SignalGuard& operator=(const SignalGuard&) = delete;
+
+private:
+    struct sigaction old_int_ {}, old_term_ {};
+};
+
+std::string numbered(const std::string& stem, int index)
+{
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "_%06d.vtp", index);
+    return stem + buffer;
+}
+
+std::string json_escape(const std::string& s)
+{
+    std::string out;
+    for (char c : s) {
+        if (c == '"' || c == '\\') out += '\\', out += c;
+        else if (c == '\n') out += "\\n";
+        else if (static_cast<unsigned char>(c) < 32) out += ' ';
+        else out += c;
+    }
+    return out;
+}
+
+std::string clock_text(double seconds)
+{
+    if (!std::isfinite(seconds) || seconds < 0.0) return "?";
+    const long s = std::lround(seconds);
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+    return buffer;
+}
+
+/// One run in its output folder: the world, its pours, the outputs and their schedule.
+class Run {
+public:
+    Run(Scenario scenario, std::string dir, const RunOptions& options)
+        : scenario_(std::move(scenario)), dir_(std::move(dir)), options_(options)
+    {
+        if (options_.threads > 0) scenario_.threads = options_.threads;
+    }
+
+    /// t = 0: the folder, the world with its fills, and the first outputs.
+    void start_fresh()
+    {
+        std::error_code error;
+        fs::create_directories(dir_, error);
+        if (error) throw InputError(concat("cannot create output folder '", dir_, "': ", error.message()));
+        for (const char* stale : {"checkpoint.bin", "checkpoint.prev.bin", "checkpoint.next.bin", "summary.json"})
+            fs::remove(fs::path(dir_) / stale, error);
+        {
+            std::ofstream copy = open_for_writing(dir_ + "/scenario.yaml");
+            copy << scenario_.text;
+            finish_writing(copy, dir_ + "/scenario.yaml");
+        }
+        world_ = build_world(scenario_);
+        build_particles(scenario_, *world_);
+        pourers_ = make_pourers(scenario_, *world_);
+        for (dem::Pourer& p : pourers_) p.update(*world_);
+        world_->prepare();
+        open_outputs(false, 0);
+        write_row();
+        write_snapshot();
+        next_csv_s_ = scenario_.output.csv_interval_s;
+        next_vtk_s_ = scenario_.output.vtk_interval_s > 0.0 ? scenario_.output.vtk_interval_s : scenario_.duration_s;
+        next_checkpoint_s_ = scenario_.output.checkpoint_interval_s > 0.0 ? scenario_.output.checkpoint_interval_s
+                                                                           : std::numeric_limits<double>::infinity();
+    }
+
+    /// Continues from a checkpoint written by checkpoint().
+    void start_from(StateReader& in)
+    {
+        world_ = build_world(scenario_);
+        pourers_ = make_pourers(scenario_, *world_);
+        world_->read_state(in);
+        in.tag("pours");
+        for (dem::Pourer& p : pourers_) p.read_state(in);
+        in.tag("outputs");
+        next_csv_s_ = in.value<double>();
+        next_vtk_s_ = in.value<double>();
+        next_checkpoint_s_ = in.value<double>();
+        snapshot_index_ = in.value<int>();
+        wall_seconds_before_ = in.value<double>();
+        steps_before_ = in.value<std::uint64_t>();
+        const auto csv_bytes = in.value<std::uint64_t>();
+        std::vector<std::vector<std::pair<double, std::string>>> entries(1 + world_->wall_count());
+        for (auto& e : entries) {
+            const auto n = in.value<std::uint64_t>();
+            if (n > in.left()) in.fail("too many snapshot entries");
+            for (std::uint64_t k = 0; k < n; ++k) {
+                const double t = in.value<double>();
+                e.emplace_back(t, in.text());
+            }
+        }
+        in.finish();
+        open_outputs(true, csv_bytes);
+        particles_pvd_->restore(entries[0]);
+        for (std::size_t w = 0; w < wall_pvd_.size(); ++w)
+            if (wall_pvd_[w]) wall_pvd_[w]->restore(entries[1 + w]);
+    }
+
+    RunResult loop()
+    {
+        SignalGuard guard;
+        const auto start = std::chrono::steady_clock::now();
+        last_progress_ = start;
+        const std::uint64_t first_step = world_->step_count();
+        const bool terminal = isatty(fileno(stderr)) != 0;
+        const double end_s = scenario_.duration_s;
+        const double dt = world_->step_s();
+        RunResult result;
+        // the run ends at the first step that reaches duration_s (within a millionth of a step)
+        const auto reached = [&](double t) { return world_->time_s() >= t - 1e-6 * dt; };
+        try {
+            while (!reached(end_s)) {
+                world_->step();
+                if (world_->step_count() % kPourEvery == 0)
+                    for (dem::Pourer& p : pourers_) p.update(*world_);
+                if (reached(next_csv_s_)) {
+                    write_row();
+                    while (reached(next_csv_s_)) next_csv_s_ += scenario_.output.csv_interval_s;
+                }
+                if (reached(next_vtk_s_) || reached(end_s)) {
+                    write_snapshot();
+                    while (reached(next_vtk_s_))
+                        next_vtk_s_ += scenario_.output.vtk_interval_s > 0.0 ? scenario_.output.vtk_interval_s : end_s;
+                }
+                if (reached(next_checkpoint_s_)) {
+                    while (reached(next_checkpoint_s_)) next_checkpoint_s_ += scenario_.output.checkpoint_interval_s;
+                    checkpoint(start);
+                }
+                if (options_.progress) progress(start, first_step, terminal, false);
+                if (g_signal != 0 || (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))) {
+                    checkpoint(start);
+                    result.status = RunStatus::interrupted;
+                    result.message = g_signal != 0 ? concat("stopped by signal ", static_cast<int>(g_signal))
+                                                   : concat("stopped at t = ", world_->time_s(), " s as asked");
+                    break;
+                }
+            }
+            if (result.status == RunStatus::completed) {
+                if (scenario_.output.csv_interval_s > 0.0 && last_row_step_ != world_->step_count()) write_row();
+                checkpoint(start);
+            }
+        } catch (const SimulationError& e) {
+            result.status = RunStatus::diverged;
+            result.message = e.what();
+        }
+        if (options_.progress) progress(start, first_step, terminal, true);
+        result.time_s = world_->time_s();
+        result.steps = world_->step_count();
+        write_summary(result, start);
+        return result;
+    }
+
+private:
+    static constexpr std::uint64_t kPourEvery = 20;  ///< steps between pour insertions
+
+    void open_outputs(bool resuming, std::uint64_t csv_bytes)
+    {
+        particles_pvd_ = std::make_unique<dem::PvdCollection>(dir_ + "/particles.pvd");
+        wall_pvd_.clear();
+        for (std::size_t w = 0; w < world_->wall_count(); ++w) {
+            if (world_->is_mesh(static_cast<int>(w)))
+                wall_pvd_.push_back(std::make_unique<dem::PvdCollection>(dir_ + "/wall_" + world_->wall_name(static_cast<int>(w)) + ".pvd"));
+            else
+                wall_pvd_.push_back(nullptr);
+        }
+        const std::string csv_path = dir_ + "/probes.csv";
+        if (resuming) {
+            std::error_code error;
+            if (!fs::exists(csv_path) || fs::file_size(csv_path) < csv_bytes)
+                throw InputError(concat("'", csv_path, "' is shorter than at the checkpoint; it cannot be continued"));
+            fs::resize_file(csv_path, csv_bytes, error);
+            if (error) throw InputError(concat("cannot trim '", csv_path, "': ", error.message()));
+            csv_.open(csv_path, std::ios::app);
+            if (!csv_) throw InputError(concat("cannot append to '", csv_path, "'"));
+            csv_.precision(10);
+            return;
+        }
+        csv_ = open_for_writing(csv_path);
+        csv_ << "time_s,step,particles,mass_kg,kinetic_energy_J,pair_contacts,wall_contacts,max_overlap_ratio";
+        for (std::size_t w = 0; w < world_->wall_count(); ++w)
+            for (const char* axis : {"x", "y", "z"}) csv_ << ",force_" << world_->wall_name(static_cast<int>(w)) << "_" << axis << "_N";
+        for (const RegionProbe& r : scenario_.regions) csv_ << "," << r.name << "_mass_kg";
+        csv_ << ",wall_clock_s\n";
+        finish_writing(csv_, csv_path);
+    }
+
+    double region_mass_kg(const RegionProbe& r) const
+    {
+        const dem::ParticleStore& p = world_->particles();
+        double mass = 0.0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            const Vec3& x = p.position_m[i];
+            if (x.x >= r.min_m.x && x.x <= r.max_m.x && x.y >= r.min_m.y && x.y <= r.max_m.y && x.z >= r.min_m.z && x.z <= r.max_m.z)
+                mass += p.mass_kg[i];
+        }
+        return mass;
+    }
+
+    void write_row()
+    {
+        const dem::World& w = *world_;
+        csv_ << w.time_s() << ',' << w.step_count() << ',' << w.particles().size() << ',' << w.total_mass_kg() << ','
+             << w.kinetic_energy_J() << ',' << w.pair_contact_count() << ',' << w.wall_contact_count() << ','
+             << w.max_overlap_ratio();
+        for (std::size_t k = 0; k < w.wall_count(); ++k) {
+            const Vec3 f = w.wall_force_N(static_cast<int>(k));
+            csv_ << ',' << f.x << ',' << f.y << ',' << f.z;
+        }
+        for (const RegionProbe& r : scenario_.regions) csv_ << ',' << region_mass_kg(r);
+        csv_ << ',' << wall_seconds_now() << '\n';
+        finish_writing(csv_, dir_ + "/probes.csv");
+        last_row_step_ = w.step_count();
+    }
+
+    void write_snapshot()
+    {
+        const std::string file = numbered("particles", snapshot_index_);
+        dem::write_particles_vtp(*world_, dir_ + "/" + file);
+        particles_pvd_->add(world_->time_s(), file);
+        for (std::size_t w = 0; w < wall_pvd_.size(); ++w) {
+            if (!wall_pvd_[w]) continue;
+            const std::string name = "wall_" + world_->wall_name(static_cast<int>(w));
+            const std::string mesh_file = numbered(name, snapshot_index_);
+            dem::write_mesh_vtp(world_->mesh_wall(static_cast<int>(w)), dir_ + "/" + mesh_file);
+            wall_pvd_[w]->add(world_->time_s(), mesh_file);
+        }
+        ++snapshot_index_;
+    }
+
+    double wall_seconds_now() const
+    {
+        return wall_seconds_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
+    }
+
+    void checkpoint(std::chrono::steady_clock::time_point)
+    {
+        StateWriter out;
+        out.tag("run");
+        out.text(scenario_.text);
+        out.text(scenario_.source);
+        out.text(scenario_.base_dir);
+        out.value<std::int32_t>(world_->threads());
+        world_->write_state(out);
+        out.tag("pours");
+        for (const dem::Pourer& p : pourers_) p.write_state(out);
+        out.tag("outputs");
+        out.value(next_csv_s_);
+        out.value(next_vtk_s_);
+        out.value(next_checkpoint_s_);
+        out.value(snapshot_index_);
+        out.value(wall_seconds_now());
+        out.value<std::uint64_t>(world_->step_count());
+        csv_.flush();
+        out.value<std::uint64_t>(static_cast<std::uint64_t>(csv_.tellp()));
+        const auto write_entries = [&](const dem::PvdCollection* c) {
+            const auto& e = c ? c->entries() : std::vector<std::pair<double, std::string>>{};
+            out.value<std::uint64_t>(e.size());
+            for (const auto& [t, f] : e) {
+                out.value(t);
+                out.text(f);
+            }
+        };
+        write_entries(particles_pvd_.get());
+        for (const auto& w : wall_pvd_) write_entries(w.get());
+        // the new file first, then the old one becomes the previous: a good checkpoint always exists
+        const fs::path dir(dir_);
+        out.save((dir / "checkpoint.next.bin").string(), kCheckpointMagic);
+        std::error_code error;
+        if (fs::exists(dir / "checkpoint.bin")) fs::rename(dir / "checkpoint.bin", dir / "checkpoint.prev.bin", error);
+        fs::rename(dir / "checkpoint.next.bin", dir / "checkpoint.bin", error);
+        if (error) throw InputError(concat("cannot move the checkpoint into place in '", dir_, "': ", error.message()));
+    }
+
+    void progress(std::chrono::steady_clock::time_point start, std::uint64_t first_step, bool terminal, bool last)
+    {
+        const auto now = std::chrono::steady_clock::now();
+        const double since = std::chrono::duration<double>(now - last_progress_).count();
+        const double interval = terminal ? 0.5 : scenario_.output.progress_interval_s;
+        if (!last && since < interval) return;
+        last_progress_ = now;
+        const double elapsed = std::chrono::duration<double>(now - start).count();
+        const double steps = static_cast<double>(world_->step_count() - first_step);
+        const double rate = elapsed > 0.0 ? steps / elapsed : 0.0;
+        const double t = world_->time_s(), end = scenario_.duration_s;
+        const double left_steps = std::max(0.0, (end - t) / world_->step_s());
+        const double eta = rate > 0.0 ? left_steps / rate : -1.0;
+        char line[256];
+        std::snprintf(line, sizeof line, "t = %.4g / %.4g s (%3.0f%%)  %.0f steps/s  %.3g particle-steps/s  ETA %s", t, end,
+                      100.0 * std::min(1.0, t / end), rate, rate * static_cast<double>(world_->particles().size()),
+                      clock_text(eta).c_str());
+        if (terminal) std::fprintf(stderr, "\r%-100s%s", line, last ? "\n" : "");
+        else std::fprintf(stderr, "%s\n", line);
+        std::fflush(stderr);
+    }
+
+    void write_summary(const RunResult& result, std::chrono::steady_clock::time_point start)
+    {
+        const dem::World& w = *world_;
+        const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double steps = static_cast<double>(w.step_count() - steps_before_);
+        const char* status = result.status == RunStatus::completed ? "completed"
+                             : result.status == RunStatus::interrupted ? "interrupted" : "diverged";
+        std::ofstream out = open_for_writing(dir_ + "/summary.json");
+        out.precision(10);
+        char hash[32];
+        std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(particle_state_hash(w)));
+        out << "{\n  \"name\": \"" << json_escape(scenario_.name) << "\",\n  \"status\": \"" << status << "\",\n"
+            << "  \"message\": \"" << json_escape(result.message) << "\",\n"
+            << "  \"time_s\": " << w.time_s() << ",\n  \"duration_s\": " << scenario_.duration_s << ",\n"
+            << "  \"steps\": " << w.step_count() << ",\n  \"step_s\": " << w.step_s() << ",\n"
+            << "  \"threads\": " << w.threads() << ",\n  \"particles\": " << w.particles().size() << ",\n"
+            << "  \"mass_kg\": " << w.total_mass_kg() << ",\n  \"kinetic_energy_J\": " << w.kinetic_energy_J() << ",\n"
+            << "  \"wall_forces_N\": {";
+        for (std::size_t k = 0; k < w.wall_count(); ++k) {
+            const Vec3 f = w.wall_force_N(static_cast<int>(k));
+            out << (k ? ", " : "") << "\"" << json_escape(w.wall_name(static_cast<int>(k))) << "\": [" << f.x << ", " << f.y
+                << ", " << f.z << "]";
+        }
+        out << "},\n  \"region_mass_kg\": {";
+        for (std::size_t k = 0; k < scenario_.regions.size(); ++k)
+            out << (k ? ", " : "") << "\"" << json_escape(scenario_.regions[k].name) << "\": " << region_mass_kg(scenario_.regions[k]);
+        out << "},\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
+            << ",\n  \"particle_steps_per_s\": "
+            << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
+            << "  \"state_hash\": \"" << hash << "\"\n}\n";
+        finish_writing(out, dir_ + "/summary.json");
+    }
+
+    Scenario scenario_;
+    std::string dir_;
+    RunOptions options_;
+    std::unique_ptr<dem::World> world_;
+    std::vector<dem::Pourer> pourers_;
+    std::unique_ptr<dem::PvdCollection> particles_pvd_;
+    std::vector<std::unique_ptr<dem::PvdCollection>> wall_pvd_;
+    std::ofstream csv_;
+    double next_csv_s_ = 0.0, next_vtk_s_ = 0.0, next_checkpoint_s_ = 0.0;
+    int snapshot_index_ = 0;
+    double wall_seconds_before_ = 0.0;
+    std::uint64_t steps_before_ = 0, last_row_step_ = ~0ull;
+    std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now(), last_progress_;
+};
+
+}  // namespace
+
+std::uint64_t particle_state_hash(const dem::World& world)
+{
+    const dem::ParticleStore& p = world.particles();
+    std::vector<std::size_t> order(p.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+    std::uint64_t hash = kFnvOffset;
+    for (std::size_t i : order) {
+        hash = fnv1a(&p.id[i], sizeof p.id[i], hash);
+        hash = fnv1a(&p.position_m[i], sizeof(Vec3), hash);
+        hash = fnv1a(&p.velocity_m_per_s[i], sizeof(Vec3), hash);
+        hash = fnv1a(&p.angular_velocity_rad_per_s[i], sizeof(Vec3), hash);
+    }
+    return hash;
+}
+
+RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, const RunOptions& options)
+{
+    Run run(scenario, out_dir, options);
+    run.start_fresh();
+    return run.loop();
+}
+
+RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)
+{
+    const fs::path dir(out_dir);
+    const std::string path = checkpoint_file.empty() ? (dir / "checkpoint.bin").string() : checkpoint_file;
+    if (!fs::exists(path)) {
+        std::string hint;
+        if (fs::exists(dir / "checkpoint.next.bin") || fs::exists(dir / "checkpoint.prev.bin"))
+            hint = concat("; try --from ", fs::exists(dir / "checkpoint.next.bin") ? (dir / "checkpoint.next.bin").string()
+                                                                                   : (dir / "checkpoint.prev.bin").string());
+        throw InputError(concat("no checkpoint '", path, "' to resume from", hint));
+    }
+    std::unique_ptr<StateReader> in;
+    try {
+        in = std::make_unique<StateReader>(path, kCheckpointMagic);
+    } catch (const InputError& e) {
+        const bool prev = checkpoint_file.empty() && fs::exists(dir / "checkpoint.prev.bin");
+        throw InputError(concat(e.what(), prev ? concat("; the previous checkpoint is kept: dipper resume ", out_dir, " --from ",
+                                                          (dir / "checkpoint.prev.bin").string())
+                                               : std::string()));
+    }
+    in->tag("run");
+    const std::string text = in->text(), source = in->text(), base_dir = in->text();
+    const int threads = in->value<std::int32_t>();
+    Scenario scenario = parse_scenario(text, source, base_dir);
+    RunOptions o = options;
+    if (o.threads <= 0) o.threads = threads;  // same thread count, same bits
+    Run run(std::move(scenario), out_dir, o);
+    run.start_from(*in);
+    return run.loop();
+}
+
+int exit_code(const RunResult& result)
+{
+    switch (result.status) {
+    case RunStatus::completed: return 0;
+    case RunStatus::diverged: return 3;
+    case RunStatus::interrupted: return 130;
+    }
+    return 1;
+}
+
+}  // namespace dipper::scenario

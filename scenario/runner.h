@@ -1,0 +1,37 @@
+// Running a scenario: the time loop with its outputs (ParaView series, probes.csv, summary.json),
+// progress lines, checkpoints (at an interval, on SIGINT/SIGTERM and at the end) and resuming from one.
+#pragma once
+
+#include "scenario/scenario.h"
+
+#include <string>
+
+namespace dipper::scenario {
+
+enum class RunStatus { completed, interrupted, diverged };
+
+struct RunOptions {
+    int threads = -1;         ///< > 0 replaces the scenario's threads (resume: the checkpoint's count)
+    bool progress = true;     ///< progress lines on stderr
+    double stop_after_s = 0;  ///< > 0: stop with a checkpoint once simulated time reaches this (tests, batch queues)
+};
+
+struct RunResult {
+    RunStatus status = RunStatus::completed;
+    std::string message;      ///< the diagnosis of a diverged run
+    double time_s = 0.0;
+    std::uint64_t steps = 0;
+};
+
+/// Runs a scenario from t = 0, writing into out_dir (created; files of an earlier run there are replaced).
+RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, const RunOptions& options);
+/// Continues the run in out_dir from its checkpoint (out_dir/checkpoint.bin, or `checkpoint_file` if given).
+RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file = "");
+
+/// FNV-1a hash of every particle's position, velocity and spin in id order: equal hashes, equal states.
+std::uint64_t particle_state_hash(const dem::World& world);
+
+/// Exit code of the dipper command for a result: 0 completed, 3 diverged, 130 interrupted.
+int exit_code(const RunResult& result);
+
+}  // namespace dipper::scenario

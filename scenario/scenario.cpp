@@ -1,0 +1,510 @@
+#include "scenario/scenario.h"
+
+#include "core/errors.h"
+#include "meshes/mesh_io.h"
+#include "scenario/keys.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace dipper::scenario {
+
+namespace {
+
+std::string joined(const std::vector<std::string>& names)
+{
+    std::string s;
+    for (std::size_t k = 0; k < names.size(); ++k) s += (k ? ", " : "") + names[k];
+    return s;
+}
+
+/// One YAML map of the scenario, read through the key table: every key it holds must be in the table,
+/// every key read must be in the table, and an absent key takes the table's default.
+class MapReader {
+public:
+    MapReader(YAML::Node node, std::string spec_path, std::string shown_path, const std::string& source,
+              YAML::Mark mark)
+        : node_(std::move(node)), spec_(std::move(spec_path)), shown_(std::move(shown_path)), source_(source), mark_(mark)
+    {
+        if (!node_.IsDefined() || node_.IsNull()) {
+            node_ = YAML::Node(YAML::NodeType::Map);
+            return;
+        }
+        mark_ = node_.Mark();
+        if (!node_.IsMap())
+            throw InputError(concat(position(node_.Mark()), shown_.empty() ? "the file" : shown_, ": got ", shown(node_),
+                                    "; expected a map of keys (key: value)"));
+        const std::vector<std::string> valid = child_keys(spec_);
+        for (auto it = node_.begin(); it != node_.end(); ++it) {
+            const std::string key = it->first.Scalar();
+            bool known = false;
+            for (const auto& v : valid) known = known || v == key;
+            if (!known)
+                throw InputError(concat(position(it->first.Mark()), "unknown key '", full(key), "'; valid keys",
+                                        spec_.empty() ? "" : concat(" under '", shown_, "'"), " are: ", joined(valid)));
+        }
+    }
+
+    /// The value under key; nullopt if the key is absent or has no value (`key:` or `key: ~`).
+    std::optional<YAML::Node> find(const std::string& key) const
+    {
+        for (auto it = node_.begin(); it != node_.end(); ++it)
+            if (it->first.Scalar() == key) {
+                if (it->second.IsNull()) return std::nullopt;
+                return it->second;
+            }
+        return std::nullopt;
+    }
+    std::optional<YAML::Mark> key_mark(const std::string& key) const
+    {
+        for (auto it = node_.begin(); it != node_.end(); ++it)
+            if (it->first.Scalar() == key) return it->first.Mark();
+        return std::nullopt;
+    }
+
+    bool has(const std::string& key) const { return find(key).has_value(); }
+
+    /// "FILE:LINE:COL: key.path" of a key (of the map itself if the key is absent).
+    std::string where(const std::string& key) const
+    {
+        const auto n = find(key);
+        const auto k = key_mark(key);
+        return concat(position(n ? n->Mark() : (k ? *k : mark_)), full(key));
+    }
+
+    double number(const std::string& key) const
+    {
+        const std::string text = scalar(key, "a number");
+        char* end = nullptr;
+        errno = 0;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v))
+            fail(key, concat("\"", text, "\""), concat("a finite number", unit_hint(key)));
+        return v;
+    }
+
+    std::int64_t integer(const std::string& key) const
+    {
+        const std::string text = scalar(key, "an integer");
+        char* end = nullptr;
+        errno = 0;
+        const long long v = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE) fail(key, concat("\"", text, "\""), "an integer");
+        return v;
+    }
+
+    std::string text(const std::string& key) const { return scalar(key, "a text"); }
+    std::optional<std::string> optional_text(const std::string& key) const
+    {
+        if (!has(key)) return std::nullopt;
+        return text(key);
+    }
+
+    bool boolean(const std::string& key) const
+    {
+        const std::string text = scalar(key, "true or false");
+        if (text == "true") return true;
+        if (text == "false") return false;
+        fail(key, concat("\"", text, "\""), "true or false");
+    }
+
+    Vec3 vector3(const std::string& key) const
+    {
+        const YAML::Node n = has(key) ? *find(key) : YAML::Load(default_of(key));
+        if (!n.IsSequence() || n.size() != 3) fail(key, shown(n), concat("a list of 3 numbers [x, y, z]", unit_hint(key)));
+        Vec3 v;
+        for (int a = 0; a < 3; ++a) {
+            const std::string text = n[a].IsScalar() ? n[a].Scalar() : "";
+            char* end = nullptr;
+            const double x = std::strtod(text.c_str(), &end);
+            if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x))
+                fail(key, shown(n), concat("a list of 3 finite numbers [x, y, z]", unit_hint(key)));
+            (a == 0 ? v.x : a == 1 ? v.y : v.z) = x;
+        }
+        return v;
+    }
+
+    MapReader map(const std::string& key) const
+    {
+        spec_of(key);
+        if (!has(key) && default_of(key) == "required") fail(key, "nothing", "a map (this key is required)");
+        return MapReader(has(key) ? *find(key) : YAML::Node(), child_spec(key), full(key), source_, mark_);
+    }
+
+    std::vector<MapReader> maps(const std::string& key) const
+    {
+        spec_of(key);
+        std::vector<MapReader> out;
+        if (!has(key)) {
+            if (default_of(key) == "required") fail(key, "nothing", "a list (this key is required)");
+            return out;
+        }
+        const YAML::Node n = *find(key);
+        if (!n.IsSequence()) fail(key, shown(n), "a list of maps");
+        for (std::size_t k = 0; k < n.size(); ++k)
+            out.emplace_back(n[k], child_spec(key) + "[]", concat(full(key), "[", k, "]"), source_, n[k].Mark());
+        return out;
+    }
+
+    std::vector<std::string> texts(const std::string& key) const
+    {
+        spec_of(key);
+        if (!has(key)) fail(key, "nothing", "a list of names");
+        const YAML::Node n = *find(key);
+        if (!n.IsSequence()) fail(key, shown(n), "a list of names");
+        std::vector<std::string> out;
+        for (const auto& item : n) {
+            if (!item.IsScalar()) fail(key, shown(n), "a list of names");
+            out.push_back(item.Scalar());
+        }
+        return out;
+    }
+
+    [[noreturn]] void fail(const std::string& key, const std::string& got, const std::string& expected) const
+    {
+        throw InputError(concat(where(key), ": got ", got, "; expected ", expected));
+    }
+
+private:
+    std::string full(const std::string& key) const { return shown_.empty() ? key : shown_ + "." + key; }
+    std::string child_spec(const std::string& key) const { return spec_.empty() ? key : spec_ + "." + key; }
+    const KeySpec& spec_of(const std::string& key) const
+    {
+        const KeySpec* s = find_key(child_spec(key));
+        DIPPER_ASSERT(s != nullptr, "the parser reads key '" + child_spec(key) + "' that the key table lacks");
+        return *s;
+    }
+    std::string default_of(const std::string& key) const { return spec_of(key).default_value; }
+    std::string unit_hint(const std::string& key) const
+    {
+        const std::string d = spec_of(key).description;
+        return d.empty() ? "" : concat(" (", d, ")");
+    }
+    std::string position(const YAML::Mark& m) const
+    {
+        return concat(source_, ":", m.line + 1, ":", m.column + 1, ": ");
+    }
+    static std::string shown(const YAML::Node& n)
+    {
+        if (n.IsScalar()) return concat("\"", n.Scalar(), "\"");
+        YAML::Emitter e;
+        e << YAML::Flow << n;
+        return e.c_str();
+    }
+    std::string scalar(const std::string& key, const char* expected) const
+    {
+        const KeySpec& spec = spec_of(key);
+        if (!has(key)) {
+            if (spec.default_value == "required") fail(key, "nothing", concat(expected, " (this key is required)"));
+            DIPPER_ASSERT(spec.default_value != "none", "optional key without a default read as a value: " + spec.path);
+            return spec.default_value;
+        }
+        const YAML::Node n = *find(key);
+        if (!n.IsScalar()) fail(key, shown(n), expected);
+        return n.Scalar();
+    }
+
+    YAML::Node node_;
+    std::string spec_, shown_;
+    const std::string& source_;
+    YAML::Mark mark_;
+};
+
+dem::SizeDistribution read_sizes(const MapReader& r)
+{
+    dem::SizeDistribution d;
+    for (const MapReader& s : r.maps("sizes")) {
+        const double radius = s.number("radius_m"), fraction = s.number("mass_fraction");
+        require_positive(radius, "radius_m", s.where("radius_m"));
+        require_in_range(fraction, 0.0, 1.0, "mass_fraction", s.where("mass_fraction"));
+        d.classes.push_back({radius, fraction});
+    }
+    if (d.classes.empty()) r.fail("sizes", "an empty list", "at least one size class");
+    d.validate(r.where("sizes"));
+    return d;
+}
+
+void read_box(const MapReader& r, Vec3& lo, Vec3& hi, const char* lo_key, const char* hi_key)
+{
+    lo = r.vector3(lo_key);
+    hi = r.vector3(hi_key);
+    for (int a = 0; a < 3; ++a)
+        if (!(hi[a] > lo[a]))
+            r.fail(hi_key, concat("[", hi.x, ", ", hi.y, ", ", hi.z, "]"),
+                   concat("each coordinate above ", lo_key, " [", lo.x, ", ", lo.y, ", ", lo.z, "]"));
+}
+
+void read_materials(const MapReader& top, Scenario& s)
+{
+    const MapReader m = top.map("materials");
+    const std::string preset = m.text("preset");
+    const double density = m.number("particle_density_kg_per_m3");
+    require_positive(density, "particle_density_kg_per_m3", m.where("particle_density_kg_per_m3"));
+    if (preset == "aitik_copper_ore") s.materials = dem::MaterialTable::aitik_copper_ore(density);
+    else if (preset == "none") s.materials = dem::MaterialTable{};
+    else m.fail("preset", concat("\"", preset, "\""), "aitik_copper_ore or none");
+
+    for (const MapReader& a : m.maps("add")) {
+        dem::Material mat;
+        mat.name = a.text("name");
+        mat.is_surface = a.boolean("surface");
+        mat.density_kg_per_m3 = a.number("density_kg_per_m3");
+        mat.youngs_modulus_Pa = a.number("youngs_modulus_Pa");
+        mat.poisson_ratio = a.number("poisson_ratio");
+        for (std::size_t k = 0; k < s.materials.size(); ++k)
+            if (s.materials.material(static_cast<dem::MaterialIndex>(k)).name == mat.name)
+                a.fail("name", concat("\"", mat.name, "\""), "a name not already in the table");
+        dem::validate(mat, a.where("name"));
+        s.materials.add(mat);
+    }
+    for (const MapReader& p : m.maps("pairs")) {
+        const std::vector<std::string> names = p.texts("materials");
+        if (names.size() != 2) p.fail("materials", concat(names.size(), " names"), "two material names [a, b]");
+        dem::MaterialIndex ia = 0, ib = 0;
+        try {
+            ia = s.materials.index_of(names[0]);
+            ib = s.materials.index_of(names[1]);
+        } catch (const InputError& e) {
+            throw InputError(concat(p.where("materials"), ": ", e.what()));
+        }
+        dem::PairCoefficients c = s.materials.has_pair(ia, ib) ? s.materials.pair(ia, ib) : dem::PairCoefficients{};
+        const auto set = [&](const char* key, double& field) {
+            if (p.has(key) || !s.materials.has_pair(ia, ib)) field = p.number(key);
+        };
+        set("normal_stiffness_scale", c.normal_stiffness_scale);
+        set("tangential_stiffness_scale", c.tangential_stiffness_scale);
+        set("friction", c.friction);
+        set("rolling_friction", c.rolling_friction);
+        set("normal_damping_ratio", c.normal_damping_ratio);
+        set("tangential_damping_ratio", c.tangential_damping_ratio);
+        s.materials.set_pair(ia, ib, c, p.where("materials"));
+    }
+}
+
+std::string material_known(const Scenario& s, const MapReader& r, const std::string& key, bool surface)
+{
+    const std::string name = r.text(key);
+    for (std::size_t k = 0; k < s.materials.size(); ++k) {
+        const dem::Material& m = s.materials.material(static_cast<dem::MaterialIndex>(k));
+        if (m.name != name) continue;
+        if (m.is_surface != surface)
+            r.fail(key, concat("\"", name, "\""), surface ? "a surface material (a wall)" : "a particle material (not a surface)");
+        return name;
+    }
+    std::vector<std::string> names;
+    for (std::size_t k = 0; k < s.materials.size(); ++k) {
+        const dem::Material& m = s.materials.material(static_cast<dem::MaterialIndex>(k));
+        if (m.is_surface == surface) names.push_back(m.name);
+    }
+    r.fail(key, concat("\"", name, "\""), concat("one of the ", surface ? "surface" : "particle", " materials: ", joined(names)));
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& text, const std::string& source, const std::string& base_dir)
+{
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw InputError(concat(source, ":", e.mark.line + 1, ":", e.mark.column + 1, ": not valid YAML: ", e.msg));
+    }
+    Scenario s;
+    s.source = source;
+    s.text = text;
+    s.base_dir = base_dir;
+    const MapReader top(root, "", "", s.source, YAML::Mark());
+
+    const std::int64_t version = top.integer("dipper_scenario");
+    if (version != 1) top.fail("dipper_scenario", concat(version), "1 (the format this dipper reads)");
+    s.name = top.optional_text("name").value_or(std::filesystem::path(source).stem().string());
+    const std::int64_t seed = top.integer("seed");
+    if (seed < 0) top.fail("seed", concat(seed), "an integer >= 0");
+    s.seed = static_cast<std::uint64_t>(seed);
+    const std::int64_t threads = top.integer("threads");
+    if (threads < 0 || threads > 1024) top.fail("threads", concat(threads), "0 (all cores) or a thread count up to 1024");
+    s.threads = static_cast<int>(threads);
+    s.gravity_m_per_s2 = top.vector3("gravity_m_per_s2");
+
+    const MapReader time = top.map("time");
+    s.duration_s = time.number("duration_s");
+    require_positive(s.duration_s, "duration_s", time.where("duration_s"));
+    s.step_s = time.number("step_s");
+    require_non_negative(s.step_s, "step_s", time.where("step_s"));
+
+    read_materials(top, s);
+
+    for (const MapReader& p : top.maps("planes")) {
+        PlaneSpec plane;
+        plane.name = p.text("name");
+        plane.point_m = p.vector3("point_m");
+        plane.normal = p.vector3("normal");
+        if (!(norm(plane.normal) > 0.0)) p.fail("normal", "[0, 0, 0]", "a non-zero vector");
+        plane.normal = plane.normal * (1.0 / norm(plane.normal));
+        plane.material = material_known(s, p, "material", true);
+        s.planes.push_back(plane);
+    }
+    for (const MapReader& m : top.maps("meshes")) {
+        MeshSpec mesh;
+        mesh.where = m.where("file");
+        mesh.name = m.text("name");
+        mesh.file = m.text("file");
+        mesh.material = material_known(s, m, "material", true);
+        mesh.scale = m.number("scale");
+        require_positive(mesh.scale, "scale", m.where("scale"));
+        mesh.translate_m = m.vector3("translate_m");
+        if (m.has("motion")) {
+            const MapReader mo = m.map("motion");
+            dem::PrescribedMotion motion;
+            motion.velocity_m_per_s = mo.vector3("velocity_m_per_s");
+            motion.angular_velocity_rad_per_s = mo.vector3("angular_velocity_rad_per_s");
+            motion.pivot_m = mo.vector3("pivot_m");
+            motion.oscillation_amplitude_m = mo.vector3("oscillation_amplitude_m");
+            motion.oscillation_frequency_Hz = mo.number("oscillation_frequency_Hz");
+            require_non_negative(motion.oscillation_frequency_Hz, "oscillation_frequency_Hz", mo.where("oscillation_frequency_Hz"));
+            mesh.motion = motion;
+        }
+        s.meshes.push_back(mesh);
+    }
+    // wall names are unique across planes and meshes
+    {
+        std::vector<std::string> names;
+        for (const auto& p : s.planes) names.push_back(p.name);
+        for (const auto& m : s.meshes) names.push_back(m.name);
+        for (std::size_t a = 0; a < names.size(); ++a)
+            for (std::size_t b = a + 1; b < names.size(); ++b)
+                if (names[a] == names[b])
+                    throw InputError(concat(s.source, ": wall name '", names[a], "' is used twice; planes and meshes need unique names"));
+    }
+
+    for (const MapReader& f : top.maps("fills")) {
+        FillSpec fill;
+        fill.where = f.where("mass_kg");
+        fill.material = material_known(s, f, "material", false);
+        fill.mass_kg = f.number("mass_kg");
+        require_positive(fill.mass_kg, "mass_kg", f.where("mass_kg"));
+        const MapReader box = f.map("box");
+        read_box(box, fill.min_m, fill.max_m, "min_m", "max_m");
+        fill.sizes = read_sizes(f);
+        s.fills.push_back(fill);
+    }
+    for (const MapReader& p : top.maps("pours")) {
+        PourSpec pour;
+        pour.where = p.where("mass_kg");
+        pour.material = material_known(s, p, "material", false);
+        pour.mass_kg = p.number("mass_kg");
+        require_positive(pour.mass_kg, "mass_kg", p.where("mass_kg"));
+        pour.rate_kg_per_s = p.number("rate_kg_per_s");
+        require_positive(pour.rate_kg_per_s, "rate_kg_per_s", p.where("rate_kg_per_s"));
+        pour.velocity_m_per_s = p.vector3("velocity_m_per_s");
+        const MapReader box = p.map("box");
+        read_box(box, pour.min_m, pour.max_m, "min_m", "max_m");
+        pour.sizes = read_sizes(p);
+        s.pours.push_back(pour);
+    }
+    if (s.fills.empty() && s.pours.empty())
+        throw InputError(concat(s.source, ": the scenario has no particles; add a 'fills' or a 'pours' entry"));
+
+    const MapReader probes = top.map("probes");
+    for (const MapReader& r : probes.maps("regions")) {
+        RegionProbe region;
+        region.name = r.text("name");
+        read_box(r, region.min_m, region.max_m, "min_m", "max_m");
+        s.regions.push_back(region);
+    }
+
+    const MapReader out = top.map("output");
+    s.output.vtk_interval_s = out.number("vtk_interval_s");
+    require_non_negative(s.output.vtk_interval_s, "vtk_interval_s", out.where("vtk_interval_s"));
+    s.output.csv_interval_s = out.number("csv_interval_s");
+    require_positive(s.output.csv_interval_s, "csv_interval_s", out.where("csv_interval_s"));
+    s.output.checkpoint_interval_s = out.number("checkpoint_interval_s");
+    require_non_negative(s.output.checkpoint_interval_s, "checkpoint_interval_s", out.where("checkpoint_interval_s"));
+    s.output.progress_interval_s = out.number("progress_interval_s");
+    require_positive(s.output.progress_interval_s, "progress_interval_s", out.where("progress_interval_s"));
+    return s;
+}
+
+Scenario load_scenario(const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in) throw InputError(concat("cannot open scenario file '", path, "'"));
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::filesystem::path p = std::filesystem::absolute(path);
+    return parse_scenario(text.str(), path, p.parent_path().string());
+}
+
+std::unique_ptr<dem::World> build_world(const Scenario& s)
+{
+    dem::WorldSettings settings;
+    settings.gravity_m_per_s2 = s.gravity_m_per_s2;
+    settings.step_s = s.step_s;
+    settings.threads = s.threads;
+    auto world = std::make_unique<dem::World>(s.materials, settings);
+    for (const PlaneSpec& p : s.planes) world->add_plane(p.point_m, p.normal, s.materials.index_of(p.material), p.name);
+    for (const MeshSpec& m : s.meshes) {
+        const std::filesystem::path file = std::filesystem::path(m.file).is_absolute()
+                                               ? std::filesystem::path(m.file)
+                                               : std::filesystem::path(s.base_dir) / m.file;
+        meshes::TriangleMesh mesh;
+        try {
+            mesh = meshes::load_triangle_mesh(file.string(), m.scale);
+        } catch (const InputError& e) {
+            throw InputError(concat(m.where, ": ", e.what()));
+        }
+        std::vector<Vec3> vertices = mesh.vertices_m();
+        for (Vec3& v : vertices) v += m.translate_m;
+        mesh = meshes::TriangleMesh(std::move(vertices), mesh.triangles(), file.string());
+        world->add_mesh(std::move(mesh), s.materials.index_of(m.material), m.name, m.motion);
+    }
+    return world;
+}
+
+void check_pairs(const Scenario& s, const dem::World& world)
+{
+    std::vector<std::string> particle_materials;
+    for (const auto& f : s.fills) particle_materials.push_back(f.material);
+    for (const auto& p : s.pours) particle_materials.push_back(p.material);
+    std::vector<std::string> others = particle_materials;
+    for (const auto& p : s.planes) others.push_back(p.material);
+    for (const auto& m : s.meshes) others.push_back(m.material);
+    for (const std::string& a : particle_materials)
+        for (const std::string& b : others)
+            if (!s.materials.has_pair(s.materials.index_of(a), s.materials.index_of(b)))
+                throw InputError(concat(s.source, ": materials '", a, "' and '", b,
+                                        "' meet but have no pair coefficients; add them under materials.pairs"));
+    (void)world;
+}
+
+void build_particles(const Scenario& s, dem::World& world)
+{
+    for (std::size_t k = 0; k < s.fills.size(); ++k) {
+        const FillSpec& f = s.fills[k];
+        try {
+            dem::fill_random(world, dem::BoxRegion(f.min_m, f.max_m), f.sizes, s.materials.index_of(f.material), f.mass_kg,
+                             s.seed * 1000003ull + k);
+        } catch (const InputError& e) {
+            throw InputError(concat(f.where, ": ", e.what()));
+        }
+    }
+}
+
+std::vector<dem::Pourer> make_pourers(const Scenario& s, const dem::World& world)
+{
+    std::vector<dem::Pourer> pourers;
+    for (std::size_t k = 0; k < s.pours.size(); ++k) {
+        const PourSpec& p = s.pours[k];
+        pourers.emplace_back(dem::BoxRegion(p.min_m, p.max_m), p.sizes, world.materials().index_of(p.material),
+                             p.rate_kg_per_s, p.mass_kg, p.velocity_m_per_s, s.seed * 7919ull + 17ull * k + 1ull);
+    }
+    return pourers;
+}
+
+}  // namespace dipper::scenario

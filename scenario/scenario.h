@@ -1,0 +1,94 @@
+// A scenario: one run described in a YAML file (docs/scenario.md lists every key). Parsing checks every
+// key and value where it enters; building turns the description into a DEM world.
+#pragma once
+
+#include "core/vec3.h"
+#include "dem/insertion.h"
+#include "dem/material.h"
+#include "dem/walls.h"
+#include "dem/world.h"
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dipper::scenario {
+
+struct PlaneSpec {
+    std::string name, material;
+    Vec3 point_m, normal;
+};
+
+struct MeshSpec {
+    std::string name, file, material;  ///< file: absolute, or relative to Scenario::base_dir
+    double scale = 1.0;
+    Vec3 translate_m;
+    std::optional<dem::PrescribedMotion> motion;
+    std::string where;                 ///< file:line:col of the entry, for errors found when loading the mesh
+};
+
+struct FillSpec {
+    std::string material = "ore";
+    double mass_kg = 0.0;
+    Vec3 min_m, max_m;
+    dem::SizeDistribution sizes;
+    std::string where;
+};
+
+struct PourSpec {
+    std::string material = "ore";
+    double mass_kg = 0.0, rate_kg_per_s = 0.0;
+    Vec3 velocity_m_per_s;
+    Vec3 min_m, max_m;
+    dem::SizeDistribution sizes;
+    std::string where;
+};
+
+struct RegionProbe {
+    std::string name;
+    Vec3 min_m, max_m;
+};
+
+struct OutputSpec {
+    double vtk_interval_s = 0.1, csv_interval_s = 0.01, checkpoint_interval_s = 0.0, progress_interval_s = 10.0;
+};
+
+/// A parsed, checked scenario.
+struct Scenario {
+    std::string source;    ///< the file it came from (for messages)
+    std::string text;      ///< the file's text, kept so that a checkpoint carries its own scenario
+    std::string base_dir;  ///< folder that relative file names are taken from
+    std::string name;
+    std::uint64_t seed = 1;
+    int threads = 0;
+    Vec3 gravity_m_per_s2{0.0, 0.0, -9.81};
+    double duration_s = 0.0, step_s = 0.0;
+    dem::MaterialTable materials;
+    std::vector<PlaneSpec> planes;
+    std::vector<MeshSpec> meshes;
+    std::vector<FillSpec> fills;
+    std::vector<PourSpec> pours;
+    std::vector<RegionProbe> regions;
+    OutputSpec output;
+};
+
+/// Reads and checks a scenario file. Errors are InputErrors of the form
+/// "FILE:LINE:COL: key.path: got VALUE; expected ...", an unknown key listing the valid ones.
+Scenario load_scenario(const std::string& path);
+/// The same from text; `source` names it in messages and `base_dir` resolves relative file names.
+Scenario parse_scenario(const std::string& text, const std::string& source, const std::string& base_dir);
+
+/// The DEM world a scenario describes, with its walls; particles come from fills (build_particles) or a
+/// checkpoint. Mesh files that cannot be read are InputErrors naming the scenario entry.
+std::unique_ptr<dem::World> build_world(const Scenario& scenario);
+/// Checks that every particle material of the fills and pours has coefficients with every other one and
+/// with every wall's material; throws an InputError naming the pair and the scenario otherwise.
+void check_pairs(const Scenario& scenario, const dem::World& world);
+/// Places the fills' particles (seeded by the scenario's seed and the fill's position in the list).
+void build_particles(const Scenario& scenario, dem::World& world);
+/// The pours, ready to run from t = 0.
+std::vector<dem::Pourer> make_pourers(const Scenario& scenario, const dem::World& world);
+
+}  // namespace dipper::scenario
