@@ -43,6 +43,10 @@ public:
         const std::vector<std::string> valid = child_keys(spec_);
         for (auto it = node_.begin(); it != node_.end(); ++it) {
             const std::string key = it->first.Scalar();
+            for (auto before = node_.begin(); before != it; ++before)
+                if (before->first.Scalar() == key)
+                    throw InputError(concat(position(it->first.Mark()), "key '", full(key), "' appears twice (first on line ",
+                                            before->first.Mark().line + 1, "); give each key once"));
             bool known = false;
             for (const auto& v : valid) known = known || v == key;
             if (!known)
@@ -483,12 +487,48 @@ void check_pairs(const Scenario& s, const dem::World& world)
     (void)world;
 }
 
+namespace {
+
+/// A fill box less what the walls take: a sphere must lie on the particle side of every plane and
+/// clear of every mesh wall's surface (in its pose at t = 0).
+class ClearOfWalls final : public dem::Region {
+public:
+    ClearOfWalls(const Vec3& lo, const Vec3& hi, const dem::World& world) : box_(lo, hi), world_(world) {}
+    bool holds(const Vec3& c, double r) const override
+    {
+        if (!box_.holds(c, r)) return false;
+        for (std::size_t w = 0; w < world_.wall_count(); ++w) {
+            const int id = static_cast<int>(w);
+            if (!world_.is_mesh(id)) {
+                const dem::PlaneWall& p = world_.plane_wall(id);
+                if (dot(c - p.point_m, p.normal) < r) return false;
+                continue;
+            }
+            const dem::MeshWall& m = world_.mesh_wall(id);
+            // in the mesh's body frame (x_body = R^T (x - T)); a bounding-box test first
+            const Vec3 b = m.rotation().transposed() * (c - m.translation_m());
+            const Vec3 lo = m.mesh().bounds_min_m(), hi = m.mesh().bounds_max_m();
+            if (b.x < lo.x - r || b.y < lo.y - r || b.z < lo.z - r || b.x > hi.x + r || b.y > hi.y + r || b.z > hi.z + r) continue;
+            if (m.mesh().distance_m(b) < r) return false;
+        }
+        return true;
+    }
+    Vec3 bounds_min_m() const override { return box_.bounds_min_m(); }
+    Vec3 bounds_max_m() const override { return box_.bounds_max_m(); }
+
+private:
+    dem::BoxRegion box_;
+    const dem::World& world_;
+};
+
+}  // namespace
+
 void build_particles(const Scenario& s, dem::World& world)
 {
     for (std::size_t k = 0; k < s.fills.size(); ++k) {
         const FillSpec& f = s.fills[k];
         try {
-            dem::fill_random(world, dem::BoxRegion(f.min_m, f.max_m), f.sizes, s.materials.index_of(f.material), f.mass_kg,
+            dem::fill_random(world, ClearOfWalls(f.min_m, f.max_m, world), f.sizes, s.materials.index_of(f.material), f.mass_kg,
                              s.seed * 1000003ull + k);
         } catch (const InputError& e) {
             throw InputError(concat(f.where, ": ", e.what()));

@@ -86,7 +86,8 @@ std::unique_ptr<dem::World> build_world(const Scenario& scenario);
 /// Checks that every particle material of the fills and pours has coefficients with every other one and
 /// with every wall's material; throws an InputError naming the pair and the scenario otherwise.
 void check_pairs(const Scenario& scenario, const dem::World& world);
-/// Places the fills' particles (seeded by the scenario's seed and the fill's position in the list).
+/// Places the fills' particles (seeded by the scenario's seed and the fill's position in the list), clear
+/// of the walls.
 void build_particles(const Scenario& scenario, dem::World& world);
 /// The pours, ready to run from t = 0.
 std::vector<dem::Pourer> make_pourers(const Scenario& scenario, const dem::World& world);

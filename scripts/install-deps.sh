@@ -9,6 +9,7 @@ packages=(
   libbullet-dev        # rigid rocks and the shovel (double-precision libraries)
   libeigen3-dev        # small dense linear algebra (principal axes of inertia)
   libccd-dev           # independent sphere-convex penetration, checked against our own in the tests
+  libyaml-cpp-dev      # scenario files
   catch2               # unit and analytic tests (v2.13)
   libbenchmark-dev     # micro-benchmarks
   libomp-dev           # OpenMP runtime headers for clang users; g++ ships libgomp

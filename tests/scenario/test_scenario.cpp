@@ -1,0 +1,339 @@
+// Scenario files: every class of input error names the file, line, column, key path, value and what
+// was expected; the key table and docs/scenario.md agree; runs resume bit for bit from checkpoints;
+// a diverging run stops with a diagnosis and keeps its files.
+#include "core/errors.h"
+#include "core/state_io.h"
+#include "scenario/keys.h"
+#include "scenario/runner.h"
+#include "scenario/scenario.h"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+using namespace dipper;
+using namespace dipper::scenario;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A small valid scenario: 60 spheres poured into a 1 m box with a moving mesh paddle.
+std::string small_scenario(const std::string& extra = "", double duration_s = 0.3)
+{
+    return concat(R"(dipper_scenario: 1
+name: small
+seed: 7
+threads: 2
+time:
+  duration_s: )", duration_s, R"(
+planes:
+  - {name: floor, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+  - {name: wall_x0, point_m: [0, 0, 0], normal: [1, 0, 0], material: bucket}
+  - {name: wall_x1, point_m: [1, 0, 0], normal: [-1, 0, 0], material: bucket}
+  - {name: wall_y0, point_m: [0, 0, 0], normal: [0, 1, 0], material: bucket}
+  - {name: wall_y1, point_m: [0, 1, 0], normal: [0, -1, 0], material: bucket}
+meshes:
+  - name: paddle
+    file: )", DIPPER_SOURCE_DIR, R"(/meshes/generated/ground.stl
+    material: bucket
+    scale: 0.02
+    translate_m: [0.5, 0.5, 0.6]
+    motion: {velocity_m_per_s: [0, 0, -0.3], angular_velocity_rad_per_s: [0, 0, 2.0], pivot_m: [0.5, 0.5, 0.6]}
+fills:
+  - mass_kg: 300
+    box: {min_m: [0, 0, 0], max_m: [1, 1, 0.5]}
+    sizes: [{radius_m: 0.05, mass_fraction: 0.5}, {radius_m: 0.04, mass_fraction: 0.5}]
+pours:
+  - mass_kg: 100
+    rate_kg_per_s: 1000
+    velocity_m_per_s: [0, 0, -1]
+    box: {min_m: [0, 0, 0.8], max_m: [1, 1, 1.2]}
+    sizes: [{radius_m: 0.05, mass_fraction: 1.0}]
+probes:
+  regions: [{name: low, min_m: [0, 0, 0], max_m: [1, 1, 0.3]}]
+output:
+  vtk_interval_s: 0.1
+  csv_interval_s: 0.01
+)", extra);
+}
+
+/// The InputError message of parsing `text`, or "" if it parsed.
+std::string error_of(const std::string& text)
+{
+    try {
+        parse_scenario(text, "case.yaml", ".");
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+std::string read_file(const std::string& path)
+{
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string summary_value(const std::string& dir, const std::string& key)
+{
+    const std::string text = read_file(dir + "/summary.json");
+    const std::regex re("\"" + key + "\": \"?([^\",\n]*)");
+    std::smatch m;
+    REQUIRE(std::regex_search(text, m, re));
+    return m[1];
+}
+
+/// probes.csv without its last column (wall-clock seconds, which no two runs share).
+std::string probes_without_clock(const std::string& dir)
+{
+    std::istringstream in(read_file(dir + "/probes.csv"));
+    std::string line, out;
+    while (std::getline(in, line)) out += line.substr(0, line.rfind(',')) + "\n";
+    return out;
+}
+
+RunOptions quiet()
+{
+    RunOptions o;
+    o.progress = false;
+    return o;
+}
+
+}  // namespace
+
+TEST_CASE("a valid scenario parses with its values and the table's defaults", "[scenario]")
+{
+    const Scenario s = parse_scenario(small_scenario(), "small.yaml", ".");
+    CHECK(s.name == "small");
+    CHECK(s.seed == 7);
+    CHECK(s.duration_s == 0.3);
+    CHECK(s.step_s == 0.0);                       // default
+    CHECK(s.gravity_m_per_s2 == Vec3{0, 0, -9.81});  // default
+    CHECK(s.planes.size() == 5);
+    REQUIRE(s.meshes.size() == 1);
+    REQUIRE(s.meshes[0].motion);
+    CHECK(s.meshes[0].motion->angular_velocity_rad_per_s == Vec3{0, 0, 2.0});
+    CHECK(s.fills[0].material == "ore");          // default
+    CHECK(s.fills[0].sizes.classes.size() == 2);
+    CHECK(s.output.checkpoint_interval_s == 0.0);
+    CHECK(s.output.progress_interval_s == 10.0);
+    CHECK(s.materials.size() == dem::MaterialTable::aitik_copper_ore().size());
+}
+
+TEST_CASE("every class of scenario error names file, line, column, key, value and expectation", "[scenario]")
+{
+    // unknown key: a typo is an error that lists the valid keys of its map
+    std::string e = error_of(small_scenario() + "outptu: {}\n");
+    CHECK_THAT(e, Catch::Contains("case.yaml:") && Catch::Contains("unknown key 'outptu'") &&
+                      Catch::Contains("valid keys are: dipper_scenario, name, seed"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("duration_s"), "duration"));
+    CHECK_THAT(e, Catch::Contains("case.yaml:6:3: unknown key 'time.duration'") && Catch::Contains("duration_s, step_s"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("radius_m: 0.04"), "radius: 0.04"));
+    CHECK_THAT(e, Catch::Contains("unknown key 'fills[0].sizes[1].radius'"));
+
+    // wrong type, with the value received
+    e = error_of(std::regex_replace(small_scenario(), std::regex("duration_s: 0.3"), "duration_s: fast"));
+    CHECK_THAT(e, Catch::Contains("case.yaml:6:15: time.duration_s: got \"fast\"; expected a finite number"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("normal: \\[0, 0, 1\\]"), "normal: [0, 1]"));
+    CHECK_THAT(e, Catch::Contains("case.yaml:8:47: planes[0].normal: got [0, 1]; expected a list of 3 numbers"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("seed: 7"), "seed: 7.5"));
+    CHECK_THAT(e, Catch::Contains("case.yaml:3:7: seed: got \"7.5\"; expected an integer"));
+
+    // missing required key
+    e = error_of(std::regex_replace(small_scenario(), std::regex("    rate_kg_per_s: 1000\n"), ""));
+    CHECK_THAT(e, Catch::Contains("pours[0].rate_kg_per_s: got nothing; expected a number (this key is required)"));
+    e = error_of("dipper_scenario: 1\nfills: []\n");
+    CHECK_THAT(e, Catch::Contains("time: got nothing; expected a map (this key is required)"));
+
+    // out-of-range values
+    e = error_of(std::regex_replace(small_scenario(), std::regex("mass_kg: 300"), "mass_kg: -300"));
+    CHECK_THAT(e, Catch::Contains("mass_kg must be > 0 and finite; got -300") && Catch::Contains("fills[0].mass_kg"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("mass_fraction: 1.0"), "mass_fraction: 0.9"));
+    CHECK_THAT(e, Catch::Contains("pours[0].sizes"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("max_m: \\[1, 1, 0.5\\]"), "max_m: [1, 1, -0.5]"));
+    CHECK_THAT(e, Catch::Contains("fills[0].box.max_m: got [1, 1, -0.5]; expected each coordinate above min_m"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("dipper_scenario: 1"), "dipper_scenario: 2"));
+    CHECK_THAT(e, Catch::Contains("case.yaml:1:18: dipper_scenario: got 2; expected 1"));
+
+    // names that do not exist, or of the wrong kind
+    e = error_of(std::regex_replace(small_scenario(), std::regex("material: ground"), "material: gravel"));
+    CHECK_THAT(e, Catch::Contains("planes[0].material: got \"gravel\"; expected one of the surface materials: ground, bucket"));
+    e = error_of(small_scenario() + "fills:\n  - {material: bucket, mass_kg: 1, box: {min_m: [0,0,0], max_m: [1,1,1]}, sizes: [{radius_m: 0.1, mass_fraction: 1}]}\n");
+    CHECK_THAT(e, Catch::Contains("case.yaml:35:1: key 'fills' appears twice (first on line 20)"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("name: wall_y1"), "name: wall_y0"));
+    CHECK_THAT(e, Catch::Contains("wall name 'wall_y0' is used twice"));
+
+    // not YAML at all
+    e = error_of("dipper_scenario: 1\ntime: {duration_s: 1\n");
+    CHECK_THAT(e, Catch::Contains("case.yaml:") && Catch::Contains("not valid YAML"));
+    e = error_of("- just\n- a list\n");
+    CHECK_THAT(e, Catch::Contains("the file: got") && Catch::Contains("expected a map of keys"));
+
+    // pair coefficients for a material that does not exist
+    e = error_of(small_scenario() + "materials:\n  pairs:\n    - {materials: [ore, granite], friction: 0.5}\n");
+    CHECK_THAT(e, Catch::Contains("materials.pairs[0].materials") && Catch::Contains("granite"));
+}
+
+TEST_CASE("a mesh file that cannot be read names the scenario entry", "[scenario]")
+{
+    const Scenario s = parse_scenario(std::regex_replace(small_scenario(), std::regex("ground.stl"), "no_such.stl"), "case.yaml", ".");
+    try {
+        build_world(s);
+        FAIL("no error");
+    } catch (const InputError& e) {
+        CHECK_THAT(std::string(e.what()), Catch::Contains("case.yaml:15:11: meshes[0].file") && Catch::Contains("no_such.stl"));
+    }
+}
+
+TEST_CASE("materials from the file extend the preset; missing pair coefficients are named", "[scenario]")
+{
+    const std::string extra = R"(materials:
+  add:
+    - {name: liner, surface: true, density_kg_per_m3: 7800, youngs_modulus_Pa: 2.0e11, poisson_ratio: 0.3}
+  pairs:
+    - {materials: [ore, ground], friction: 0.4}
+)";
+    const Scenario s = parse_scenario(small_scenario(extra), "case.yaml", ".");
+    const auto ore = s.materials.index_of("ore"), ground = s.materials.index_of("ground");
+    CHECK(s.materials.pair(ore, ground).friction == 0.4);
+    // the other coefficients of the pair keep the preset's values (Table 2: ground rolling friction 0.3)
+    CHECK(s.materials.pair(ore, ground).rolling_friction ==
+          dem::MaterialTable::aitik_copper_ore().pair(ore, ground).rolling_friction);
+    CHECK_FALSE(s.materials.has_pair(ore, s.materials.index_of("liner")));
+
+    const Scenario t = parse_scenario(std::regex_replace(small_scenario(extra), std::regex("material: ground"), "material: liner"),
+                                      "case.yaml", ".");
+    const auto world = build_world(t);
+    CHECK_THROWS_WITH(check_pairs(t, *world), Catch::Contains("materials 'ore' and 'liner' meet but have no pair coefficients"));
+}
+
+TEST_CASE("docs/scenario.md lists exactly the keys the parser reads, with their types and defaults", "[scenario]")
+{
+    const std::string doc = read_file(std::string(DIPPER_SOURCE_DIR) + "/docs/scenario.md");
+    REQUIRE_FALSE(doc.empty());
+    // table rows: | `path` | type | `default` | meaning |
+    const std::regex row(R"(\| `([^`]+)` \| (\w+) \| `([^`]*)` \| )");
+    std::vector<std::tuple<std::string, std::string, std::string>> documented;
+    for (auto it = std::sregex_iterator(doc.begin(), doc.end(), row); it != std::sregex_iterator(); ++it)
+        documented.emplace_back((*it)[1], (*it)[2], (*it)[3]);
+    const auto& keys = scenario_keys();
+    REQUIRE(documented.size() == keys.size());
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        INFO("key " << keys[k].path);
+        CHECK(std::get<0>(documented[k]) == keys[k].path);
+        CHECK(std::get<1>(documented[k]) == keys[k].type);
+        CHECK(std::get<2>(documented[k]) == keys[k].default_value);
+    }
+}
+
+TEST_CASE("a run stopped at a checkpoint and resumed ends bit for bit as the uninterrupted run", "[scenario]")
+{
+    const fs::path base = fs::temp_directory_path() / "dipper_test_resume";
+    fs::remove_all(base);
+    const Scenario s = parse_scenario(small_scenario(), "small.yaml", ".");
+
+    const RunResult whole = run_scenario(s, (base / "whole").string(), quiet());
+    REQUIRE(whole.status == RunStatus::completed);
+
+    RunOptions stop = quiet();
+    stop.stop_after_s = 0.137;  // mid-pour, mid-interval, paddle moving
+    const RunResult first = run_scenario(s, (base / "parts").string(), stop);
+    REQUIRE(first.status == RunStatus::interrupted);
+    CHECK(first.time_s < 0.3);
+    CHECK(summary_value((base / "parts").string(), "status") == "interrupted");
+    const RunResult rest = resume_run((base / "parts").string(), quiet());
+    REQUIRE(rest.status == RunStatus::completed);
+
+    CHECK(rest.steps == whole.steps);
+    CHECK(summary_value((base / "parts").string(), "state_hash") == summary_value((base / "whole").string(), "state_hash"));
+    CHECK(probes_without_clock((base / "parts").string()) == probes_without_clock((base / "whole").string()));
+    CHECK(read_file((base / "parts" / "particles.pvd").string()) == read_file((base / "whole" / "particles.pvd").string()));
+    CHECK(read_file((base / "parts" / "particles_000003.vtp").string()) ==
+          read_file((base / "whole" / "particles_000003.vtp").string()));
+    fs::remove_all(base);
+}
+
+TEST_CASE("a truncated or corrupt checkpoint is refused and the previous one is named", "[scenario]")
+{
+    const fs::path base = fs::temp_directory_path() / "dipper_test_corrupt";
+    fs::remove_all(base);
+    const Scenario s = parse_scenario(small_scenario("", 0.2), "small.yaml", ".");
+    RunOptions stop = quiet();
+    stop.stop_after_s = 0.05;
+    REQUIRE(run_scenario(s, (base / "a").string(), stop).status == RunStatus::interrupted);
+    stop.stop_after_s = 0.1;
+    REQUIRE(resume_run((base / "a").string(), stop).status == RunStatus::interrupted);
+    const fs::path cp = base / "a" / "checkpoint.bin", prev = base / "a" / "checkpoint.prev.bin";
+    REQUIRE(fs::exists(prev));
+
+    const auto size = fs::file_size(cp);
+    fs::copy_file(cp, base / "good.bin");
+    fs::resize_file(cp, size / 2);  // truncated
+    CHECK_THROWS_WITH(resume_run((base / "a").string(), quiet()),
+                      Catch::Contains("checkpoint.bin' is corrupt or truncated") &&
+                          Catch::Contains("the previous checkpoint is kept: dipper resume") && Catch::Contains("checkpoint.prev.bin"));
+    fs::copy_file(base / "good.bin", cp, fs::copy_options::overwrite_existing);
+    {
+        std::fstream f(cp, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(static_cast<std::streamoff>(size / 3));
+        f.put('\x5a');  // one flipped byte
+    }
+    CHECK_THROWS_WITH(resume_run((base / "a").string(), quiet()), Catch::Contains("corrupt or truncated"));
+    {
+        std::ofstream f(cp, std::ios::binary | std::ios::trunc);
+        f << "something else entirely\n";
+    }
+    CHECK_THROWS_WITH(resume_run((base / "a").string(), quiet()),
+                      Catch::Contains("is not a state file of this kind") && Catch::Contains("dipper-checkpoint 1"));
+    // the previous checkpoint still resumes
+    const RunResult r = resume_run((base / "a").string(), quiet(), prev.string());
+    CHECK(r.status == RunStatus::completed);
+    fs::remove_all(base);
+}
+
+TEST_CASE("a diverging run stops with a diagnosis and keeps what it wrote", "[scenario]")
+{
+    // the paddle driven down at 40 m/s into the bed: overlaps beyond half a radius within a few steps
+    const fs::path dir = fs::temp_directory_path() / "dipper_test_diverge";
+    fs::remove_all(dir);
+    const std::string text = std::regex_replace(small_scenario(), std::regex("velocity_m_per_s: \\[0, 0, -0.3\\]"),
+                                                "velocity_m_per_s: [0, 0, -40]");
+    const RunResult r = run_scenario(parse_scenario(text, "fast.yaml", "."), dir.string(), quiet());
+    REQUIRE(r.status == RunStatus::diverged);
+    CHECK(exit_code(r) == 3);
+    CHECK_THAT(r.message, Catch::Contains("step ") && Catch::Contains("particle") && Catch::Contains("overlap") &&
+                              Catch::Contains("of the smaller radius (limit 0.5)") && Catch::Contains("reduce step_s, e.g. to"));
+    CHECK(summary_value(dir.string(), "status") == "diverged");
+    CHECK(fs::exists(dir / "particles_000000.vtp"));
+    CHECK(fs::file_size(dir / "probes.csv") > 100);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("state files refuse what does not fit the reader", "[scenario]")
+{
+    const fs::path path = fs::temp_directory_path() / "dipper_state_io.bin";
+    StateWriter w;
+    w.tag("section");
+    w.array(std::vector<double>{1.0, 2.0});
+    w.save(path.string(), "dipper-test 1");
+    {
+        StateReader r(path.string(), "dipper-test 1");
+        r.tag("section");
+        std::vector<double> v;
+        r.array(v);
+        CHECK(v == std::vector<double>{1.0, 2.0});
+        r.finish();
+    }
+    {
+        StateReader r(path.string(), "dipper-test 1");
+        CHECK_THROWS_WITH(r.tag("other"), Catch::Contains("expected section 'other', found 'section'"));
+    }
+    CHECK_THROWS_WITH(StateReader(path.string(), "dipper-test 2"), Catch::Contains("is not a state file of this kind"));
+    CHECK_THROWS_WITH(StateReader((path.string() + ".missing"), "dipper-test 1"), Catch::Contains("cannot open state file"));
+    fs::remove(path);
+}
