@@ -3,11 +3,17 @@
 //   dipper run FILE [--out DIR] [--threads N] [--stop-after S] [--quiet]
 //   dipper check FILE...
 //   dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]
+//   dipper sweep FILE [--out DIR] [--threads N] [--quiet]     (under mpirun: variants spread over ranks)
 //   dipper keys            (every scenario key as a Markdown table)
 #include "core/errors.h"
 #include "scenario/keys.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/sweep.h"
+
+#ifdef DIPPER_HAVE_MPI
+#include <mpi.h>
+#endif
 
 #include <cstdio>
 #include <cstdlib>
@@ -26,6 +32,7 @@ constexpr const char* kUsage =
     "usage: dipper run FILE [--out DIR] [--threads N] [--stop-after SECONDS] [--quiet]\n"
     "       dipper check FILE...\n"
     "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
+    "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
     "       dipper keys\n";
 
 [[noreturn]] void usage(const std::string& message)
@@ -97,6 +104,49 @@ int print_keys()
     return 0;
 }
 
+/// Runs a sweep; under mpirun (OpenMPI sets OMPI_COMM_WORLD_SIZE) the variants are dealt out to the
+/// ranks in turn, and rank 0 writes the table once all are done.
+int sweep(const Options& o)
+{
+    const Sweep sw = load_sweep(o.positional[0]);
+    const std::string dir = o.out.empty() ? "out/" + std::filesystem::path(o.positional[0]).stem().string() : o.out;
+    int rank = 0, ranks = 1;
+#ifdef DIPPER_HAVE_MPI
+    const bool under_mpi = std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr;
+    if (under_mpi) {
+        MPI_Init(nullptr, nullptr);
+        MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+        MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+    }
+#endif
+    const std::size_t n = sw.variants().size();
+    if (rank == 0) std::printf("dipper sweep: %zu variants into %s on %d process%s\n", n, dir.c_str(), ranks, ranks == 1 ? "" : "es");
+    int failed = 0;
+    std::string error;
+    try {
+        failed = run_sweep_variants(sw, dir, o.run, rank, ranks);
+    } catch (const std::exception& e) {
+        error = e.what();
+        failed = 1;
+    }
+#ifdef DIPPER_HAVE_MPI
+    if (under_mpi) {
+        int total = 0;
+        MPI_Allreduce(&failed, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+        failed = total;
+    }
+#endif
+    if (!error.empty()) std::fprintf(stderr, "dipper: rank %d: %s\n", rank, error.c_str());
+    if (rank == 0 && error.empty()) {
+        write_sweep_table(sw, dir);
+        std::printf("dipper sweep: %zu variants, %d did not complete; table: %s/sweep.csv\n", n, failed, dir.c_str());
+    }
+#ifdef DIPPER_HAVE_MPI
+    if (under_mpi) MPI_Finalize();
+#endif
+    return failed == 0 ? 0 : 3;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -137,6 +187,10 @@ int main(int argc, char** argv)
             const RunResult r = resume_run(o.positional[0], o.run, o.from);
             report(r, o.positional[0]);
             return exit_code(r);
+        }
+        if (command == "sweep") {
+            if (o.positional.size() != 1) usage("sweep needs exactly one sweep file");
+            return sweep(o);
         }
         usage("unknown command '" + command + "'");
     } catch (const InputError& e) {

@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev        # small dense linear algebra (principal axes of inertia)
   libccd-dev           # independent sphere-convex penetration, checked against our own in the tests
   libyaml-cpp-dev      # scenario files
+  libopenmpi-dev openmpi-bin  # sweeps spread over MPI ranks
+  python3-matplotlib   # run reports (figures)
   catch2               # unit and analytic tests (v2.13)
   libbenchmark-dev     # micro-benchmarks
   libomp-dev           # OpenMP runtime headers for clang users; g++ ships libgomp

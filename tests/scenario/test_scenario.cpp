@@ -6,6 +6,7 @@
 #include "scenario/keys.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/sweep.h"
 
 #include <catch2/catch.hpp>
 
@@ -336,4 +337,51 @@ TEST_CASE("state files refuse what does not fit the reader", "[scenario]")
     CHECK_THROWS_WITH(StateReader(path.string(), "dipper-test 2"), Catch::Contains("is not a state file of this kind"));
     CHECK_THROWS_WITH(StateReader((path.string() + ".missing"), "dipper-test 1"), Catch::Contains("cannot open state file"));
     fs::remove(path);
+}
+
+TEST_CASE("sweep files: variants by values and ranges, and errors that name the key", "[scenario]")
+{
+    const fs::path dir = fs::temp_directory_path() / "dipper_test_sweep";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy_file(std::string(DIPPER_SOURCE_DIR) + "/tests/data/scenarios/sweep_base.yaml", dir / "base.yaml");
+    const auto sweep_error = [&](const std::string& text) -> std::string {
+        std::ofstream(dir / "s.yaml") << text;
+        try {
+            load_sweep((dir / "s.yaml").string());
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    CHECK(sweep_error("dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: time.step_s, from: 1.0e-5, to: 2.0e-5, step: 5.0e-6}\n")
+              .empty());
+    Sweep s = load_sweep((dir / "s.yaml").string());
+    REQUIRE(s.variants().size() == 3);
+    CHECK(s.variants()[2][0] == "2e-05");
+    CHECK(s.variant_scenario(1).step_s == 1.5e-5);
+
+    std::ofstream(dir / "s.yaml") << "dipper_sweep: 1\nbase: base.yaml\nparameters:\n"
+                                     "  - {key: materials.particle_density_kg_per_m3, values: [3000, 3700]}\n"
+                                     "  - {key: \"planes[0].normal\", values: [[0, 0, 1], [0, 0.1, 1]]}\n";
+    s = load_sweep((dir / "s.yaml").string());
+    REQUIRE(s.variants().size() == 4);
+    const Scenario v3 = s.variant_scenario(3);
+    CHECK(v3.materials.material(v3.materials.index_of("ore")).density_kg_per_m3 == 3700.0);
+    CHECK(v3.planes[0].normal.y > 0.09);
+    CHECK(v3.fills[0].mass_kg == 30.0);  // the rest as in the base
+
+    CHECK_THAT(sweep_error("dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: time.stepsize, values: [1]}\n"),
+               Catch::Contains("s.yaml:4:") && Catch::Contains("key 'time.stepsize' is not a scenario key"));
+    CHECK_THAT(sweep_error("dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: time.step_s, value: [1]}\n"),
+               Catch::Contains("unknown key 'parameters[0].value'; valid keys are: key, values, from, to, step"));
+    CHECK_THAT(sweep_error("dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: time.step_s, from: 2, to: 1, step: 1}\n"),
+               Catch::Contains("expected from <= to and step > 0; got from 2, to 1, step 1"));
+    CHECK_THAT(sweep_error("dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: time.duration_s, values: [-1]}\n"),
+               Catch::Contains("variant 0") && Catch::Contains("duration_s must be > 0 and finite; got -1"));
+    CHECK_THAT(sweep_error("dipper_sweep: 1\nbase: missing.yaml\nparameters:\n  - {key: seed, values: [1]}\n"),
+               Catch::Contains("cannot open base scenario") && Catch::Contains("missing.yaml"));
+    CHECK_THAT(sweep_error("dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: \"meshes[0].scale\", values: [2]}\n"),
+               Catch::Contains("has no list 'meshes'"));
+    fs::remove_all(dir);
 }

@@ -1,0 +1,264 @@
+#include "scenario/sweep.h"
+
+#include "core/errors.h"
+#include "core/files.h"
+#include "scenario/keys.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace dipper::scenario {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_text(const std::string& path, const std::string& what)
+{
+    std::ifstream in(path);
+    if (!in) throw InputError(concat("cannot open ", what, " '", path, "'"));
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string at(const std::string& source, const YAML::Node& n)
+{
+    return concat(source, ":", n.Mark().line + 1, ":", n.Mark().column + 1, ": ");
+}
+
+/// Splits `a.b[2].c` into segments; list indices as numbers, and the key-table path (`a.b[].c`).
+struct KeyPath {
+    std::vector<std::string> names;  ///< map keys
+    std::vector<long> indices;       ///< after names[k]: list index, or -1
+    std::string spec;
+};
+
+KeyPath split_key(const std::string& key, const std::string& where)
+{
+    KeyPath p;
+    static const std::regex segment(R"(([A-Za-z_][A-Za-z0-9_]*)(\[([0-9]+)\])?)");
+    std::stringstream in(key);
+    std::string part;
+    while (std::getline(in, part, '.')) {
+        std::smatch m;
+        if (!std::regex_match(part, m, segment))
+            throw InputError(concat(where, "key '", key, "': '", part, "' is not a key name, optionally with a list index [n]"));
+        p.names.push_back(m[1]);
+        p.indices.push_back(m[3].matched ? std::stol(m[3]) : -1);
+        p.spec += (p.spec.empty() ? "" : ".") + m[1].str() + (m[3].matched ? "[]" : "");
+    }
+    const KeySpec* spec = find_key(p.spec);
+    if (spec == nullptr) throw InputError(concat(where, "key '", key, "' is not a scenario key (docs/scenario.md lists them)"));
+    if (spec->type == "map" || spec->type == "list")
+        throw InputError(concat(where, "key '", key, "' is a ", spec->type, "; sweep a value inside it"));
+    return p;
+}
+
+std::string number_text(double v)
+{
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "%.12g", v);
+    return buffer;
+}
+
+/// Simple value of summary.json (numbers and strings at the top level or inside a one-level object).
+std::string json_field(const std::string& text, const std::string& key)
+{
+    const std::regex re("\"" + key + "\": \"?([^\",}\n]*)");
+    std::smatch m;
+    return std::regex_search(text, m, re) ? m[1].str() : "";
+}
+
+}  // namespace
+
+std::vector<std::vector<std::string>> Sweep::variants() const
+{
+    std::vector<std::vector<std::string>> out{{}};
+    for (const SweepParameter& p : parameters) {
+        std::vector<std::vector<std::string>> next;
+        for (const auto& v : out)
+            for (const std::string& value : p.values) {
+                auto w = v;
+                w.push_back(value);
+                next.push_back(std::move(w));
+            }
+        out = std::move(next);
+    }
+    return out;
+}
+
+Scenario Sweep::variant_scenario(std::size_t index) const
+{
+    const auto all = variants();
+    DIPPER_ASSERT(index < all.size(), "variant index out of range");
+    YAML::Node root = YAML::Load(base_text);
+    for (std::size_t k = 0; k < parameters.size(); ++k) {
+        const KeyPath path = split_key(parameters[k].key, concat(source, ": parameters[", k, "]: "));
+        YAML::Node node = root;
+        for (std::size_t s = 0; s < path.names.size(); ++s) {
+            const bool last = s + 1 == path.names.size() && path.indices[s] < 0;
+            if (!node.IsMap()) throw InputError(concat(source, ": key '", parameters[k].key, "': '", path.names[s], "' is not inside a map in ", base_source));
+            if (last) {
+                node[path.names[s]] = YAML::Load(all[index][k]);
+                break;
+            }
+            if (!node[path.names[s]] || node[path.names[s]].IsNull()) {
+                if (path.indices[s] >= 0)
+                    throw InputError(concat(source, ": key '", parameters[k].key, "': ", base_source, " has no list '", path.names[s], "'"));
+                node[path.names[s]] = YAML::Node(YAML::NodeType::Map);  // a map the base leaves to its defaults
+            }
+            YAML::Node child(node[path.names[s]]);
+            if (path.indices[s] >= 0) {
+                if (!child.IsSequence() || static_cast<std::size_t>(path.indices[s]) >= child.size())
+                    throw InputError(concat(source, ": key '", parameters[k].key, "': ", base_source, " has no item ", path.indices[s],
+                                            " in '", path.names[s], "'"));
+                const YAML::Node item = child[static_cast<std::size_t>(path.indices[s])];
+                child.reset(item);  // alias, not assignment: assignment would overwrite the list
+                if (s + 1 == path.names.size()) throw InputError(concat(source, ": key '", parameters[k].key, "' names a list item, not a value"));
+            }
+            node.reset(child);
+        }
+    }
+    YAML::Emitter e;
+    e.SetDoublePrecision(17);
+    e << root;
+    std::string text = e.c_str();
+    text += "\n";
+    return parse_scenario(text, concat(base_source, " (variant ", index, " of ", source, ")"), base_dir);
+}
+
+Sweep load_sweep(const std::string& path)
+{
+    Sweep s;
+    s.source = path;
+    const std::string text = read_text(path, "sweep file");
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw InputError(concat(path, ":", e.mark.line + 1, ":", e.mark.column + 1, ": not valid YAML: ", e.msg));
+    }
+    if (!root.IsMap()) throw InputError(concat(path, ": expected a map with dipper_sweep, base and parameters"));
+    for (auto it = root.begin(); it != root.end(); ++it) {
+        const std::string key = it->first.Scalar();
+        if (key != "dipper_sweep" && key != "base" && key != "parameters")
+            throw InputError(concat(at(path, it->first), "unknown key '", key, "'; valid keys are: dipper_sweep, base, parameters"));
+    }
+    if (!root["dipper_sweep"] || root["dipper_sweep"].Scalar() != "1")
+        throw InputError(concat(path, ": dipper_sweep: expected 1 (the format this dipper reads)"));
+    if (!root["base"] || !root["base"].IsScalar()) throw InputError(concat(path, ": base: expected the base scenario file"));
+    const fs::path dir = fs::absolute(path).parent_path();
+    const fs::path base = fs::path(root["base"].Scalar()).is_absolute() ? fs::path(root["base"].Scalar()) : dir / root["base"].Scalar();
+    s.base_source = base.string();
+    s.base_text = read_text(s.base_source, concat("base scenario (", at(path, root["base"]), "base)"));
+    s.base_dir = base.parent_path().string();
+    parse_scenario(s.base_text, s.base_source, s.base_dir);  // the base alone must be valid
+
+    const YAML::Node params = root["parameters"];
+    if (!params || !params.IsSequence() || params.size() == 0)
+        throw InputError(concat(path, ": parameters: expected a list of {key, values} or {key, from, to, step}"));
+    for (std::size_t k = 0; k < params.size(); ++k) {
+        const YAML::Node p = params[k];
+        const std::string where = concat(at(path, p), "parameters[", k, "]");
+        if (!p.IsMap()) throw InputError(concat(where, ": expected a map {key, values} or {key, from, to, step}"));
+        for (auto it = p.begin(); it != p.end(); ++it) {
+            const std::string key = it->first.Scalar();
+            if (key != "key" && key != "values" && key != "from" && key != "to" && key != "step")
+                throw InputError(concat(at(path, it->first), "unknown key 'parameters[", k, "].", key, "'; valid keys are: key, values, from, to, step"));
+        }
+        SweepParameter sp;
+        if (!p["key"] || !p["key"].IsScalar()) throw InputError(concat(where, ".key: expected a scenario key path"));
+        sp.key = p["key"].Scalar();
+        split_key(sp.key, concat(at(path, p["key"]), "parameters[", k, "].key: "));
+        if (p["values"]) {
+            if (p["from"] || p["to"] || p["step"]) throw InputError(concat(where, ": give either values or from/to/step, not both"));
+            if (!p["values"].IsSequence() || p["values"].size() == 0) throw InputError(concat(at(path, p["values"]), "parameters[", k, "].values: expected a non-empty list"));
+            for (const auto& v : p["values"]) {
+                YAML::Emitter e;
+                e << YAML::Flow << v;
+                sp.values.push_back(e.c_str());
+            }
+        } else {
+            double range[3];
+            const char* names[3] = {"from", "to", "step"};
+            for (int r = 0; r < 3; ++r) {
+                const YAML::Node n = p[names[r]];
+                if (!n || !n.IsScalar()) throw InputError(concat(where, ".", names[r], ": expected a number (or give values)"));
+                char* end = nullptr;
+                range[r] = std::strtod(n.Scalar().c_str(), &end);
+                if (*end != '\0' || !std::isfinite(range[r]))
+                    throw InputError(concat(at(path, n), "parameters[", k, "].", names[r], ": got \"", n.Scalar(), "\"; expected a number"));
+            }
+            if (!(range[2] > 0.0) || !(range[1] >= range[0]))
+                throw InputError(concat(where, ": expected from <= to and step > 0; got from ", range[0], ", to ", range[1], ", step ", range[2]));
+            const double count = std::floor((range[1] - range[0]) / range[2] + 1e-9) + 1.0;
+            if (count > 10000) throw InputError(concat(where, ": ", count, " values; at most 10000"));
+            for (int i = 0; i < static_cast<int>(count); ++i) sp.values.push_back(number_text(range[0] + i * range[2]));
+        }
+        s.parameters.push_back(sp);
+    }
+    // every variant must be a valid scenario before anything runs
+    const std::size_t n = s.variants().size();
+    if (n > 100000) throw InputError(concat(path, ": ", n, " variants; at most 100000"));
+    for (std::size_t v = 0; v < n; ++v) s.variant_scenario(v);
+    return s;
+}
+
+namespace {
+std::string variant_dir(const std::string& out_dir, std::size_t v)
+{
+    char name[32];
+    std::snprintf(name, sizeof name, "variant_%03zu", v);
+    return (fs::path(out_dir) / name).string();
+}
+}  // namespace
+
+int run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const RunOptions& options, int rank, int ranks)
+{
+    int failed = 0;
+    const std::size_t n = sweep.variants().size();
+    for (std::size_t v = 0; v < n; ++v) {
+        if (static_cast<int>(v % static_cast<std::size_t>(ranks)) != rank) continue;
+        const RunResult r = run_scenario(sweep.variant_scenario(v), variant_dir(out_dir, v), options);
+        if (r.status != RunStatus::completed) ++failed;
+    }
+    return failed;
+}
+
+void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
+{
+    const auto all = sweep.variants();
+    const std::string path = (fs::path(out_dir) / "sweep.csv").string();
+    std::ofstream out = open_for_writing(path);
+    out << "variant";
+    for (const auto& p : sweep.parameters) out << ',' << p.key;
+    out << ",status,time_s,steps,particles,mass_kg,kinetic_energy_J,state_hash";
+    // region masses and wall forces as in the first variant's summary
+    const Scenario first = sweep.variant_scenario(0);
+    for (const RegionProbe& r : first.regions) out << ',' << r.name << "_mass_kg";
+    out << '\n';
+    for (std::size_t v = 0; v < all.size(); ++v) {
+        const std::string summary_path = variant_dir(out_dir, v) + "/summary.json";
+        std::ifstream in(summary_path);
+        if (!in) throw InputError(concat("sweep variant ", v, " has no summary ('", summary_path, "'); did it run?"));
+        std::stringstream text;
+        text << in.rdbuf();
+        const std::string s = text.str();
+        out << v;
+        for (const std::string& value : all[v]) out << ",\"" << value << '"';
+        for (const char* key : {"status", "time_s", "steps", "particles", "mass_kg", "kinetic_energy_J", "state_hash"})
+            out << ',' << json_field(s, key);
+        for (const RegionProbe& r : first.regions) out << ',' << json_field(s, r.name);
+        out << '\n';
+    }
+    finish_writing(out, path);
+}
+
+}  // namespace dipper::scenario
