@@ -4,6 +4,7 @@
 //   dipper check FILE...
 //   dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]
 //   dipper sweep FILE [--out DIR] [--threads N] [--quiet]     (under mpirun: variants spread over ranks)
+//   dipper report DIR      (report.md and PNG figures from summary.json and probes.csv)
 //   dipper keys            (every scenario key as a Markdown table)
 #include "core/errors.h"
 #include "scenario/keys.h"
@@ -33,6 +34,7 @@ constexpr const char* kUsage =
     "       dipper check FILE...\n"
     "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
     "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
+    "       dipper report DIR      (report.md with figures, also written after run and resume)\n"
     "       dipper keys\n";
 
 [[noreturn]] void usage(const std::string& message)
@@ -93,6 +95,27 @@ void report(const RunResult& result, const std::string& dir)
     if (result.status == RunStatus::diverged)
         std::printf("the files written up to the failure are kept in %s; the last checkpoint (if any) can be resumed after "
                     "changing nothing, or the scenario rerun with a smaller time.step_s\n", dir.c_str());
+}
+
+/// Writes DIR/report.md and its figures with report.py (Debian's python3 and matplotlib). A missing
+/// Python is a warning, not a failure of the run.
+int make_report(const std::string& dir)
+{
+    std::string script;
+    for (const char* candidate : {DIPPER_REPORT_SCRIPT_INSTALLED, DIPPER_REPORT_SCRIPT_SOURCE})
+        if (std::filesystem::exists(candidate)) {
+            script = candidate;
+            break;
+        }
+    const char* python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    if (script.empty()) {
+        std::fprintf(stderr, "dipper: report.py not found; no report written\n");
+        return 1;
+    }
+    const std::string command = std::string(python) + " '" + script + "' '" + dir + "'";
+    const int rc = std::system(command.c_str());
+    if (rc != 0) std::fprintf(stderr, "dipper: the report could not be written (%s returned %d)\n", command.c_str(), rc);
+    return rc == 0 ? 0 : 1;
 }
 
 int print_keys()
@@ -180,13 +203,19 @@ int main(int argc, char** argv)
             const std::string dir = o.out.empty() ? "out/" + s.name : o.out;
             const RunResult r = run_scenario(s, dir, o.run);
             report(r, dir);
+            make_report(dir);
             return exit_code(r);
         }
         if (command == "resume") {
             if (o.positional.size() != 1) usage("resume needs exactly one output folder");
             const RunResult r = resume_run(o.positional[0], o.run, o.from);
             report(r, o.positional[0]);
+            make_report(o.positional[0]);
             return exit_code(r);
+        }
+        if (command == "report") {
+            if (o.positional.size() != 1) usage("report needs exactly one output folder");
+            return make_report(o.positional[0]);
         }
         if (command == "sweep") {
             if (o.positional.size() != 1) usage("sweep needs exactly one sweep file");

@@ -49,4 +49,8 @@ reader = vtk.vtkXMLPolyDataReader()
 reader.SetFileName(os.path.join(folder, walls[-1].get("file")))
 reader.Update()
 assert reader.GetOutput().GetNumberOfPolys() > 0
+report = open(os.path.join(folder, "report.md")).read()
+assert report.startswith("# kill_resume: interrupted"), report[:60]
+for png in ("kinetic_energy.png", "wall_forces.png", "mass.png"):
+    assert f"]({png})" in report and os.path.getsize(os.path.join(folder, png)) > 1000, png
 print(f"dipper run output: {len(times)} particle frames, paddle mesh, {len(rows)} probe rows, summary: ok")
