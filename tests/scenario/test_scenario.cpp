@@ -27,7 +27,7 @@ std::string small_scenario(const std::string& extra = "", double duration_s = 0.
     return concat(R"(dipper_scenario: 1
 name: small
 seed: 7
-threads: 2
+threads: 1
 time:
   duration_s: )", duration_s, R"(
 planes:
