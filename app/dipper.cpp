@@ -188,7 +188,7 @@ int main(int argc, char** argv)
             for (const std::string& file : o.positional) {
                 const Scenario s = load_scenario(file);
                 const auto world = build_world(s);  // mesh files are read and checked too
-                check_pairs(s, *world);
+                check_pairs(s);
                 double fill = 0.0, pour = 0.0;
                 for (const auto& f : s.fills) fill += f.mass_kg;
                 for (const auto& p : s.pours) pour += p.mass_kg;

@@ -39,7 +39,8 @@ try:
 
     if t:
         figure("kinetic_energy.png", "Kinetic energy of the particles", "kinetic energy [J]",
-               [("kinetic energy", [max(v, 1e-12) for v in series["kinetic_energy_J"]])], log=True)
+               [("kinetic energy", [max(v, 1e-12) if v == v else float("nan") for v in series["kinetic_energy_J"]])],
+               log=True)
         walls = sorted({c[len("force_"):-len("_z_N")] for c in columns if c.startswith("force_") and c.endswith("_z_N")})
         figure("wall_forces.png", "Force of the particles on each wall (magnitude)", "force [kN]",
                [(w, [(series[f"force_{w}_x_N"][k] ** 2 + series[f"force_{w}_y_N"][k] ** 2 +
@@ -52,20 +53,25 @@ try:
 except ImportError:
     note = "matplotlib is not installed (Debian: python3-matplotlib), so this report has no figures.\n"
 
+def g(value, scale=1.0):
+    """A number of summary.json for the table; a diverged run may have left some as null."""
+    return "not finite" if value is None else f"{value * scale:.4g}"
+
+
 lines = [f"# {summary['name']}: {summary['status']}", ""]
 if summary.get("message"):
     lines += [f"> {summary['message']}", ""]
 lines += ["| quantity | value |", "| --- | --- |",
           f"| simulated time | {summary['time_s']:.6g} s of {summary['duration_s']:.6g} s |",
           f"| steps | {summary['steps']} of {summary['step_s']:.4g} s |",
-          f"| particles | {summary['particles']} ({summary['mass_kg'] / 1000.0:.4g} t) |",
-          f"| kinetic energy at the end | {summary['kinetic_energy_J']:.4g} J |",
+          f"| particles | {summary['particles']} ({g(summary['mass_kg'], 1e-3)} t) |",
+          f"| kinetic energy at the end | {g(summary['kinetic_energy_J'])} J |",
           f"| threads, wall-clock time | {summary['threads']}, {summary['wall_clock_s']:.4g} s |",
           f"| particle-steps per second | {summary['particle_steps_per_s']:.4g} |"]
 for wall, f in summary["wall_forces_N"].items():
-    lines.append(f"| force on {wall} | ({f[0] / 1000.0:.4g}, {f[1] / 1000.0:.4g}, {f[2] / 1000.0:.4g}) kN |")
+    lines.append(f"| force on {wall} | ({g(f[0], 1e-3)}, {g(f[1], 1e-3)}, {g(f[2], 1e-3)}) kN |")
 for region, m in summary["region_mass_kg"].items():
-    lines.append(f"| mass in {region} | {m:.6g} kg |")
+    lines.append(f"| mass in {region} | {g(m)} kg |")
 lines.append("")
 if note:
     lines += [note]

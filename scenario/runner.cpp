@@ -69,6 +69,15 @@ std::string json_escape(const std::string& s)
     return out;
 }
 
+/// A number for JSON: full precision, or null where a diverged run left it non-finite.
+std::string json_number(double v)
+{
+    if (!std::isfinite(v)) return "null";
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "%.10g", v);
+    return buffer;
+}
+
 std::string clock_text(double seconds)
 {
     if (!std::isfinite(seconds) || seconds < 0.0) return "?";
@@ -174,11 +183,11 @@ public:
                 }
                 if (reached(next_checkpoint_s_)) {
                     while (reached(next_checkpoint_s_)) next_checkpoint_s_ += scenario_.output.checkpoint_interval_s;
-                    checkpoint(start);
+                    checkpoint();
                 }
                 if (options_.progress) progress(start, first_step, terminal, false);
                 if (g_signal != 0 || (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))) {
-                    checkpoint(start);
+                    checkpoint();
                     result.status = RunStatus::interrupted;
                     result.message = g_signal != 0 ? concat("stopped by signal ", static_cast<int>(g_signal))
                                                    : concat("stopped at t = ", world_->time_s(), " s as asked");
@@ -187,7 +196,7 @@ public:
             }
             if (result.status == RunStatus::completed) {
                 if (scenario_.output.csv_interval_s > 0.0 && last_row_step_ != world_->step_count()) write_row();
-                checkpoint(start);
+                checkpoint();
             }
         } catch (const SimulationError& e) {
             result.status = RunStatus::diverged;
@@ -282,7 +291,7 @@ private:
         return wall_seconds_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
     }
 
-    void checkpoint(std::chrono::steady_clock::time_point)
+    void checkpoint()
     {
         StateWriter out;
         out.tag("run");
@@ -356,19 +365,19 @@ private:
         std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(particle_state_hash(w)));
         out << "{\n  \"name\": \"" << json_escape(scenario_.name) << "\",\n  \"status\": \"" << status << "\",\n"
             << "  \"message\": \"" << json_escape(result.message) << "\",\n"
-            << "  \"time_s\": " << w.time_s() << ",\n  \"duration_s\": " << scenario_.duration_s << ",\n"
+            << "  \"time_s\": " << json_number(w.time_s()) << ",\n  \"duration_s\": " << scenario_.duration_s << ",\n"
             << "  \"steps\": " << w.step_count() << ",\n  \"step_s\": " << w.step_s() << ",\n"
             << "  \"threads\": " << w.threads() << ",\n  \"particles\": " << w.particles().size() << ",\n"
-            << "  \"mass_kg\": " << w.total_mass_kg() << ",\n  \"kinetic_energy_J\": " << w.kinetic_energy_J() << ",\n"
+            << "  \"mass_kg\": " << json_number(w.total_mass_kg()) << ",\n  \"kinetic_energy_J\": " << json_number(w.kinetic_energy_J()) << ",\n"
             << "  \"wall_forces_N\": {";
         for (std::size_t k = 0; k < w.wall_count(); ++k) {
             const Vec3 f = w.wall_force_N(static_cast<int>(k));
-            out << (k ? ", " : "") << "\"" << json_escape(w.wall_name(static_cast<int>(k))) << "\": [" << f.x << ", " << f.y
-                << ", " << f.z << "]";
+            out << (k ? ", " : "") << "\"" << json_escape(w.wall_name(static_cast<int>(k))) << "\": [" << json_number(f.x) << ", "
+                << json_number(f.y) << ", " << json_number(f.z) << "]";
         }
         out << "},\n  \"region_mass_kg\": {";
         for (std::size_t k = 0; k < scenario_.regions.size(); ++k)
-            out << (k ? ", " : "") << "\"" << json_escape(scenario_.regions[k].name) << "\": " << region_mass_kg(scenario_.regions[k]);
+            out << (k ? ", " : "") << "\"" << json_escape(scenario_.regions[k].name) << "\": " << json_number(region_mass_kg(scenario_.regions[k]));
         out << "},\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"

@@ -309,6 +309,19 @@ std::string material_known(const Scenario& s, const MapReader& r, const std::str
     r.fail(key, concat("\"", name, "\""), concat("one of the ", surface ? "surface" : "particle", " materials: ", joined(names)));
 }
 
+/// The keys fills and pours share: material, mass, box and sizes.
+ParticleSource read_source(const Scenario& s, const MapReader& r)
+{
+    ParticleSource source;
+    source.where = r.where("mass_kg");
+    source.material = material_known(s, r, "material", false);
+    source.mass_kg = r.number("mass_kg");
+    require_positive(source.mass_kg, "mass_kg", r.where("mass_kg"));
+    read_box(r.map("box"), source.min_m, source.max_m, "min_m", "max_m");
+    source.sizes = read_sizes(r);
+    return source;
+}
+
 }  // namespace
 
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::string& base_dir)
@@ -387,29 +400,13 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
                     throw InputError(concat(s.source, ": wall name '", names[a], "' is used twice; planes and meshes need unique names"));
     }
 
-    for (const MapReader& f : top.maps("fills")) {
-        FillSpec fill;
-        fill.where = f.where("mass_kg");
-        fill.material = material_known(s, f, "material", false);
-        fill.mass_kg = f.number("mass_kg");
-        require_positive(fill.mass_kg, "mass_kg", f.where("mass_kg"));
-        const MapReader box = f.map("box");
-        read_box(box, fill.min_m, fill.max_m, "min_m", "max_m");
-        fill.sizes = read_sizes(f);
-        s.fills.push_back(fill);
-    }
+    for (const MapReader& f : top.maps("fills")) s.fills.push_back(read_source(s, f));
     for (const MapReader& p : top.maps("pours")) {
         PourSpec pour;
-        pour.where = p.where("mass_kg");
-        pour.material = material_known(s, p, "material", false);
-        pour.mass_kg = p.number("mass_kg");
-        require_positive(pour.mass_kg, "mass_kg", p.where("mass_kg"));
+        static_cast<ParticleSource&>(pour) = read_source(s, p);
         pour.rate_kg_per_s = p.number("rate_kg_per_s");
         require_positive(pour.rate_kg_per_s, "rate_kg_per_s", p.where("rate_kg_per_s"));
         pour.velocity_m_per_s = p.vector3("velocity_m_per_s");
-        const MapReader box = p.map("box");
-        read_box(box, pour.min_m, pour.max_m, "min_m", "max_m");
-        pour.sizes = read_sizes(p);
         s.pours.push_back(pour);
     }
     if (s.fills.empty() && s.pours.empty())
@@ -471,7 +468,7 @@ std::unique_ptr<dem::World> build_world(const Scenario& s)
     return world;
 }
 
-void check_pairs(const Scenario& s, const dem::World& world)
+void check_pairs(const Scenario& s)
 {
     std::vector<std::string> particle_materials;
     for (const auto& f : s.fills) particle_materials.push_back(f.material);
@@ -484,7 +481,6 @@ void check_pairs(const Scenario& s, const dem::World& world)
             if (!s.materials.has_pair(s.materials.index_of(a), s.materials.index_of(b)))
                 throw InputError(concat(s.source, ": materials '", a, "' and '", b,
                                         "' meet but have no pair coefficients; add them under materials.pairs"));
-    (void)world;
 }
 
 namespace {

@@ -29,21 +29,20 @@ struct MeshSpec {
     std::string where;                 ///< file:line:col of the entry, for errors found when loading the mesh
 };
 
-struct FillSpec {
+/// Particles of a size distribution in a box: placed at t = 0 (a fill) or entering over time (a pour).
+struct ParticleSource {
     std::string material = "ore";
     double mass_kg = 0.0;
     Vec3 min_m, max_m;
     dem::SizeDistribution sizes;
-    std::string where;
+    std::string where;  ///< file:line:col of the entry's mass_kg, for errors found when placing
 };
 
-struct PourSpec {
-    std::string material = "ore";
-    double mass_kg = 0.0, rate_kg_per_s = 0.0;
+using FillSpec = ParticleSource;
+
+struct PourSpec : ParticleSource {
+    double rate_kg_per_s = 0.0;
     Vec3 velocity_m_per_s;
-    Vec3 min_m, max_m;
-    dem::SizeDistribution sizes;
-    std::string where;
 };
 
 struct RegionProbe {
@@ -85,7 +84,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
 std::unique_ptr<dem::World> build_world(const Scenario& scenario);
 /// Checks that every particle material of the fills and pours has coefficients with every other one and
 /// with every wall's material; throws an InputError naming the pair and the scenario otherwise.
-void check_pairs(const Scenario& scenario, const dem::World& world);
+void check_pairs(const Scenario& scenario);
 /// Places the fills' particles (seeded by the scenario's seed and the fill's position in the list), clear
 /// of the walls.
 void build_particles(const Scenario& scenario, dem::World& world);

@@ -255,7 +255,9 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
         for (const std::string& value : all[v]) out << ",\"" << value << '"';
         for (const char* key : {"status", "time_s", "steps", "particles", "mass_kg", "kinetic_energy_J", "state_hash"})
             out << ',' << json_field(s, key);
-        for (const RegionProbe& r : first.regions) out << ',' << json_field(s, r.name);
+        // region names are looked up inside region_mass_kg only (a wall may carry the same name)
+        const std::string regions = s.substr(std::min(s.size(), s.find("\"region_mass_kg\"")));
+        for (const RegionProbe& r : first.regions) out << ',' << json_field(regions, r.name);
         out << '\n';
     }
     finish_writing(out, path);

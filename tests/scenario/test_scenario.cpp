@@ -209,8 +209,38 @@ TEST_CASE("materials from the file extend the preset; missing pair coefficients 
 
     const Scenario t = parse_scenario(std::regex_replace(small_scenario(extra), std::regex("material: ground"), "material: liner"),
                                       "case.yaml", ".");
-    const auto world = build_world(t);
-    CHECK_THROWS_WITH(check_pairs(t, *world), Catch::Contains("materials 'ore' and 'liner' meet but have no pair coefficients"));
+    CHECK_THROWS_WITH(check_pairs(t), Catch::Contains("materials 'ore' and 'liner' meet but have no pair coefficients"));
+}
+
+TEST_CASE("fills keep clear of planes and of mesh walls inside their box", "[scenario]")
+{
+    // the paddle moved into the fill box and a sloping plane cutting through it
+    std::string text = std::regex_replace(small_scenario(), std::regex("translate_m: \\[0.5, 0.5, 0.6\\]"), "translate_m: [0.5, 0.5, 0.25]");
+    text = std::regex_replace(text, std::regex("  - \\{name: wall_y1"),
+                              "  - {name: slope, point_m: [0, 0, 0.3], normal: [0, 1, 1], material: bucket}\n  - {name: wall_y1");
+    text = std::regex_replace(text, std::regex("mass_kg: 300"), "mass_kg: 150");
+    const Scenario s = parse_scenario(text, "case.yaml", ".");
+    const auto world = build_world(s);
+    build_particles(s, *world);
+    const dem::ParticleStore& p = world->particles();
+    REQUIRE(p.size() > 100);
+    int near_paddle = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const Vec3 c = p.position_m[i];
+        const double r = p.radius_m[i];
+        for (std::size_t w = 0; w < world->wall_count(); ++w) {
+            const int id = static_cast<int>(w);
+            if (world->is_mesh(id)) {
+                const double d = world->mesh_wall(id).mesh().distance_m(c);  // body frame = world frame at t = 0
+                CHECK(d >= r);
+                near_paddle += d < 2.0 * r;
+            } else {
+                const dem::PlaneWall& plane = world->plane_wall(id);
+                CHECK(dot(c - plane.point_m, plane.normal) >= r);
+            }
+        }
+    }
+    CHECK(near_paddle > 0);  // the paddle sits inside the bed, so spheres do come close to it
 }
 
 TEST_CASE("docs/scenario.md lists exactly the keys the parser reads, with their types and defaults", "[scenario]")
@@ -310,6 +340,7 @@ TEST_CASE("a diverging run stops with a diagnosis and keeps what it wrote", "[sc
     CHECK_THAT(r.message, Catch::Contains("step ") && Catch::Contains("particle") && Catch::Contains("overlap") &&
                               Catch::Contains("of the smaller radius (limit 0.5)") && Catch::Contains("reduce step_s, e.g. to"));
     CHECK(summary_value(dir.string(), "status") == "diverged");
+    CHECK(read_file((dir / "summary.json").string()).find("nan") == std::string::npos);  // JSON has no NaN: null
     CHECK(fs::exists(dir / "particles_000000.vtp"));
     CHECK(fs::file_size(dir / "probes.csv") > 100);
     fs::remove_all(dir);
