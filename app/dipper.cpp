@@ -90,8 +90,10 @@ void report(const RunResult& result, const std::string& dir)
                 static_cast<unsigned long long>(result.steps));
     if (!result.message.empty()) std::printf("  %s\n", result.message.c_str());
     std::printf("summary (%s/summary.json):\n%s", dir.c_str(), text.str().c_str());
-    std::printf("files: %s/particles.pvd (ParaView), %s/probes.csv, %s/checkpoint.bin\n", dir.c_str(), dir.c_str(), dir.c_str());
-    if (result.status == RunStatus::interrupted) std::printf("continue with: dipper resume %s\n", dir.c_str());
+    const bool checkpointed = std::filesystem::exists(dir + "/checkpoint.bin");
+    std::printf("files: %s/particles.pvd (ParaView), %s/probes.csv%s%s\n", dir.c_str(), dir.c_str(),
+                checkpointed ? ", " : "", checkpointed ? (dir + "/checkpoint.bin").c_str() : "");
+    if (result.status == RunStatus::interrupted && checkpointed) std::printf("continue with: dipper resume %s\n", dir.c_str());
     if (result.status == RunStatus::diverged)
         std::printf("the files written up to the failure are kept in %s; the last checkpoint (if any) can be resumed after "
                     "changing nothing, or the scenario rerun with a smaller time.step_s\n", dir.c_str());

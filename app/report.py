@@ -48,7 +48,41 @@ try:
         regions = [c for c in columns if c.endswith("_mass_kg") and c != "mass_kg"]
         figure("mass.png", "Particle mass in the world and in probe regions", "mass [t]",
                [("all particles", [v / 1000.0 for v in series["mass_kg"]])] +
-               [(c[:-len("_mass_kg")], [v / 1000.0 for v in series[c]]) for c in regions])
+               [(c[:-len("_mass_kg")], [v / 1000.0 for v in series[c]]) for c in regions
+                if c != "bucket_mass_kg"])
+        if "dig_force_N" in series:
+            figure("dig_force.png", "Drive forces of the shovel (moving average)", "force [MN]",
+                   [(label, [v / 1e6 for v in series[c]]) for label, c in
+                    (("dig force (eq. 11)", "dig_force_N"), ("hoist", "hoist_force_N"), ("crowd", "crowd_force_N"))])
+            fig, ax = plt.subplots(figsize=(7, 3.6), dpi=110)
+            ax.plot(t, [v / 1000.0 for v in series["bucket_mass_kg"]], linewidth=1.2, color="tab:blue")
+            ax.set_xlabel("time [s]")
+            ax.set_ylabel("mass in the dipper [t]")
+            ax.grid(True, alpha=0.3)
+            # the fill factor is the mass over a constant (bulk density x struck volume): a second scale
+            ratios = [f / (m / 1000.0) for m, f in zip(series["bucket_mass_kg"], series["fill_factor"]) if m > 0]
+            if ratios:
+                k = ratios[0]
+                right = ax.secondary_yaxis("right", functions=(lambda m: m * k, lambda f: f / k))
+                right.set_ylabel("fill factor")
+            ax.set_title("Material in the dipper")
+            fig.tight_layout()
+            fig.savefig(os.path.join(folder, "bucket.png"))
+            plt.close(fig)
+            figures.append(("Material in the dipper", "bucket.png"))
+        passes = summary.get("passes", [])
+        if passes:
+            fig, ax = plt.subplots(figsize=(6, 3.4), dpi=110)
+            ax.bar([p["pass"] for p in passes], [p["mass_kg"] / 1000.0 for p in passes], color="tab:brown")
+            ax.set_xlabel("pass")
+            ax.set_ylabel("mass when the door opened [t]")
+            ax.set_xticks([p["pass"] for p in passes])
+            ax.set_title("Mass per pass")
+            ax.grid(True, axis="y", alpha=0.3)
+            fig.tight_layout()
+            fig.savefig(os.path.join(folder, "mass_per_pass.png"))
+            plt.close(fig)
+            figures.append(("Mass per pass", "mass_per_pass.png"))
     note = ""
 except ImportError:
     note = "matplotlib is not installed (Debian: python3-matplotlib), so this report has no figures.\n"
@@ -72,12 +106,26 @@ for wall, f in summary["wall_forces_N"].items():
     lines.append(f"| force on {wall} | ({g(f[0], 1e-3)}, {g(f[1], 1e-3)}, {g(f[2], 1e-3)}) kN |")
 for region, m in summary["region_mass_kg"].items():
     lines.append(f"| mass in {region} | {g(m)} kg |")
+if "passes" in summary:
+    lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for p in summary["passes"]:
+        lines.append(f"| {p['pass']} | {g(p['dig_start_s'])} to {g(p['dig_end_s'])} | {g(p['mass_kg'], 1e-3)} | "
+                     f"{g(p['fill_factor'])} | {g(p['mean_dig_force_N'], 1e-6)} | {g(p['peak_dig_force_N'], 1e-6)} |")
+    if not summary["passes"]:
+        lines.append("| (no dump yet) | | | | | |")
+for part, w in summary.get("wear", {}).items():
+    lines += ["", f"Wear of {part} ({w['law']}, constant {g(w['constant'])}): volume {g(w['volume_m3'])} m³, "
+              f"deepest {g(w['max_depth_mm'])} mm."]
+    if os.path.exists(os.path.join(folder, f"wear_{part}_map.png")):
+        figures.append((f"Wear rate of {part} (mm/t, seen from +z of the part)", f"wear_{part}_map.png"))
 lines.append("")
 if note:
     lines += [note]
 for title, name in figures:
     lines += [f"## {title}", "", f"![{title}]({name})", ""]
-lines += ["ParaView: open `particles.pvd` (glyph the points by `radius_m`) and the `wall_*.pvd` series.", ""]
+lines += ["ParaView: open `particles.pvd` (glyph the points by `radius_m`), the `wall_*.pvd` series, and where present "
+          "`rocks.pvd` and `wear_*.pvd` (fields depth_mm, rate_mm_per_t, mean_normal_force_N).", ""]
 with open(os.path.join(folder, "report.md"), "w") as f:
     f.write("\n".join(lines))
 print(f"report: {os.path.join(folder, 'report.md')} with {len(figures)} figures")

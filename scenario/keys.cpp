@@ -65,6 +65,11 @@ const std::vector<KeySpec>& scenario_keys()
         {"fills[].sizes", "list", "required", "size classes by mass fraction (sum 1)"},
         {"fills[].sizes[].radius_m", "number", "required", "sphere radius"},
         {"fills[].sizes[].mass_fraction", "number", "required", "fraction of the mass"},
+        {"fills[].rocks", "list", "[]", "polyhedral rock classes of a mixed fill (Bullet bodies, thesis Paper A Table 1); "
+                                       "with rocks, sizes holds one sphere class and all fractions sum to 1"},
+        {"fills[].rocks[].size_m", "number", "required", "diameter of the sphere of equal volume"},
+        {"fills[].rocks[].mass_fraction", "number", "required", "fraction of the fill's mass"},
+        {"fills[].rock_elongation_max", "number", "2", "largest length-to-width ratio of the random rock shapes (1 to 4)"},
 
         {"pours", "list", "[]", "particles entering from a box at a mass flow rate, from t = 0"},
         {"pours[].material", "string", "ore", "particle material"},
@@ -77,6 +82,30 @@ const std::vector<KeySpec>& scenario_keys()
         {"pours[].sizes", "list", "required", "size classes by mass fraction (sum 1)"},
         {"pours[].sizes[].radius_m", "number", "required", "sphere radius"},
         {"pours[].sizes[].mass_fraction", "number", "required", "fraction of the mass"},
+
+        {"coupling", "map", "{}", "spheres with rigid bodies (rocks, the shovel)"},
+        {"coupling.substeps", "integer", "5", "DEM steps per rigid-body step (docs/coupling.md)"},
+
+        {"shovel", "map", "none", "the rope shovel (docs/machine.md), driven by motion curves"},
+        {"shovel.position_m", "vector3", "[0, 0, 0]", "machine origin: on the ground, on the swing axis"},
+        {"shovel.heading_deg", "number", "0", "turn of the machine about z; 0 digs towards +x"},
+        {"shovel.rake_angle_deg", "number", "61.8", "dipper handle centre line to heel-tooth-tip line (thesis Fig. 4b)"},
+        {"shovel.wear_bars", "string", "baseline", "flat bars on the dipper bottom: baseline (none), transverse (90 deg to the flow) or diagonal (45 deg)"},
+        {"shovel.element_size_m", "number", "0.15", "largest surface element of dipper and door (contacts and wear maps)"},
+        {"shovel.material", "string", "bucket", "surface material of dipper and door (spheres); rocks see the rigid 'bucket' material"},
+        {"shovel.motion", "string", "default_cycle",
+         "default_cycle (three passes of 46 s: dig 15 s, swing, dump, return) or a CSV file of time_s, hoist_length_m, "
+         "crowd_extension_m, swing_deg, door_deg"},
+        {"shovel.start_s", "number", "0", "the motion starts at this time; before it the shovel holds its first pose (a pile settles)"},
+        {"shovel.dig_speed_factor", "number", "1", "the default cycle's dig done this many times faster (0.5 to 2)"},
+        {"shovel.bulk_density_kg_per_m3", "number", "1903", "bulk density for the fill factor: mass in the dipper / (bulk density x struck volume)"},
+
+        {"wear", "list", "[]", "wear surfaces: contact work on a machine part summed into wear (docs/wear.md)"},
+        {"wear[].part", "string", "required", "dipper, door, or the name of a mesh wall"},
+        {"wear[].law", "string", "force_work", "archard, finnie, force_work (thesis eq. 2.8) or impact_energy"},
+        {"wear[].constant", "number", "required", "the law's constant: K (archard, m3/(N m)), phi (force_work, m3/J), "
+                                                  "K (impact_energy, m3/J); finnie: the flow stress, Pa"},
+        {"wear[].smoothing_iterations", "integer", "2", "volume-conserving smoothing of the nodal wear (thesis Paper B 3.4)"},
 
         {"probes", "map", "{}", "quantities written to probes.csv besides the standard columns"},
         {"probes.regions", "list", "[]", "boxes whose particle mass is recorded (particles by centre)"},

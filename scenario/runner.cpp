@@ -4,6 +4,8 @@
 #include "core/files.h"
 #include "core/state_io.h"
 #include "dem/output.h"
+#include "scenario/rigid_scene.h"
+#include "wear/wear_output.h"
 
 #include <algorithm>
 #include <chrono>
@@ -110,7 +112,12 @@ public:
             finish_writing(copy, dir_ + "/scenario.yaml");
         }
         world_ = build_world(scenario_);
+        if (scenario_.uses_coupling()) rigid_ = std::make_unique<RigidScene>(scenario_, *world_);
         build_particles(scenario_, *world_);
+        if (rigid_) {
+            rigid_->fill_mixed(scenario_);
+            rigid_->add_wear(scenario_);
+        }
         pourers_ = make_pourers(scenario_, *world_);
         for (dem::Pourer& p : pourers_) p.update(*world_);
         world_->prepare();
@@ -128,6 +135,7 @@ public:
     {
         world_ = build_world(scenario_);
         pourers_ = make_pourers(scenario_, *world_);
+        DIPPER_ASSERT(!scenario_.uses_coupling(), "coupled runs write no checkpoints");
         world_->read_state(in);
         in.tag("pours");
         for (dem::Pourer& p : pourers_) p.read_state(in);
@@ -139,6 +147,7 @@ public:
         wall_seconds_before_ = in.value<double>();
         steps_before_ = in.value<std::uint64_t>();
         const auto csv_bytes = in.value<std::uint64_t>();
+        walls_ = all_walls();
         std::vector<std::vector<std::pair<double, std::string>>> entries(1 + world_->wall_count());
         for (auto& e : entries) {
             const auto n = in.value<std::uint64_t>();
@@ -169,8 +178,10 @@ public:
         const auto reached = [&](double t) { return world_->time_s() >= t - 1e-6 * dt; };
         try {
             while (!reached(end_s)) {
-                world_->step();
-                if (world_->step_count() % kPourEvery == 0)
+                const std::uint64_t before = world_->step_count();
+                if (rigid_) rigid_->step();
+                else world_->step();
+                if (world_->step_count() / kPourEvery != before / kPourEvery)
                     for (dem::Pourer& p : pourers_) p.update(*world_);
                 if (reached(next_csv_s_)) {
                     write_row();
@@ -191,6 +202,7 @@ public:
                     result.status = RunStatus::interrupted;
                     result.message = g_signal != 0 ? concat("stopped by signal ", static_cast<int>(g_signal))
                                                    : concat("stopped at t = ", world_->time_s(), " s as asked");
+                    if (rigid_) result.message += "; runs with rocks, a shovel or wear write no checkpoint yet, so this one cannot be resumed";
                     break;
                 }
             }
@@ -203,6 +215,7 @@ public:
             result.message = e.what();
         }
         if (options_.progress) progress(start, first_step, terminal, true);
+        if (rigid_) write_wear_maps();
         result.time_s = world_->time_s();
         result.steps = world_->step_count();
         write_summary(result, start);
@@ -212,15 +225,30 @@ public:
 private:
     static constexpr std::uint64_t kPourEvery = 20;  ///< steps between pour insertions
 
+    /// The walls that outputs list: all of them, less the hulls of rocks.
+    std::vector<int> all_walls() const
+    {
+        if (rigid_) return rigid_->listed_walls();
+        std::vector<int> walls;
+        for (std::size_t w = 0; w < world_->wall_count(); ++w) walls.push_back(static_cast<int>(w));
+        return walls;
+    }
+
     void open_outputs(bool resuming, std::uint64_t csv_bytes)
     {
+        walls_ = all_walls();
         particles_pvd_ = std::make_unique<dem::PvdCollection>(dir_ + "/particles.pvd");
         wall_pvd_.clear();
-        for (std::size_t w = 0; w < world_->wall_count(); ++w) {
-            if (world_->is_mesh(static_cast<int>(w)))
-                wall_pvd_.push_back(std::make_unique<dem::PvdCollection>(dir_ + "/wall_" + world_->wall_name(static_cast<int>(w)) + ".pvd"));
+        for (int w : walls_) {
+            if (world_->is_mesh(w))
+                wall_pvd_.push_back(std::make_unique<dem::PvdCollection>(dir_ + "/wall_" + world_->wall_name(w) + ".pvd"));
             else
                 wall_pvd_.push_back(nullptr);
+        }
+        if (rigid_) {
+            if (!rigid_->coupled().rocks().empty()) rocks_pvd_ = std::make_unique<dem::PvdCollection>(dir_ + "/rocks.pvd");
+            for (const SceneWear& w : rigid_->wear())
+                wear_pvd_.push_back(std::make_unique<dem::PvdCollection>(dir_ + "/wear_" + w.spec.part + ".pvd"));
         }
         const std::string csv_path = dir_ + "/probes.csv";
         if (resuming) {
@@ -236,10 +264,17 @@ private:
         }
         csv_ = open_for_writing(csv_path);
         csv_ << "time_s,step,particles,mass_kg,kinetic_energy_J,pair_contacts,wall_contacts,max_overlap_ratio";
-        for (std::size_t w = 0; w < world_->wall_count(); ++w)
-            for (const char* axis : {"x", "y", "z"}) csv_ << ",force_" << world_->wall_name(static_cast<int>(w)) << "_" << axis << "_N";
+        for (int w : walls_)
+            for (const char* axis : {"x", "y", "z"}) csv_ << ",force_" << world_->wall_name(w) << "_" << axis << "_N";
         for (const RegionProbe& r : scenario_.regions) csv_ << "," << r.name << "_mass_kg";
-        csv_ << ",wall_clock_s\n";
+        if (rigid_) {
+            csv_ << ",rocks,rock_kinetic_energy_J,rock_contacts";
+            if (rigid_->has_shovel())
+                csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,swing_deg,door_deg,handle_angle_deg,"
+                        "crowd_extension_m,tooth_tip_x_m,tooth_tip_y_m,tooth_tip_z_m";
+            for (const SceneWear& w : rigid_->wear()) csv_ << ",wear_" << w.spec.part << "_m3";
+        }
+        csv_ << ",wall_s_per_step,wall_clock_s\n";
         finish_writing(csv_, csv_path);
     }
 
@@ -261,12 +296,28 @@ private:
         csv_ << w.time_s() << ',' << w.step_count() << ',' << w.particles().size() << ',' << w.total_mass_kg() << ','
              << w.kinetic_energy_J() << ',' << w.pair_contact_count() << ',' << w.wall_contact_count() << ','
              << w.max_overlap_ratio();
-        for (std::size_t k = 0; k < w.wall_count(); ++k) {
-            const Vec3 f = w.wall_force_N(static_cast<int>(k));
+        for (int k : walls_) {
+            const Vec3 f = w.wall_force_N(k);
             csv_ << ',' << f.x << ',' << f.y << ',' << f.z;
         }
         for (const RegionProbe& r : scenario_.regions) csv_ << ',' << region_mass_kg(r);
-        csv_ << ',' << wall_seconds_now() << '\n';
+        if (rigid_) {
+            const rigid::RigidWorld& rw = rigid_->rigid();
+            csv_ << ',' << rigid_->coupled().rocks().size() << ',' << rw.kinetic_energy_J() << ',' << rw.contact_point_count();
+            if (rigid_->has_shovel()) {
+                const BucketContents b = rigid_->bucket();
+                const rigid::ShovelReading& r = rigid_->reading();
+                csv_ << ',' << b.mass_kg << ',' << b.fill_factor << ',' << r.crowd_force_filtered_N << ',' << r.hoist_force_filtered_N << ','
+                     << r.dig_force_filtered_N << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
+                     << r.crowd_extension_m << ',' << r.tooth_tip_m.x << ',' << r.tooth_tip_m.y << ',' << r.tooth_tip_m.z;
+            }
+            for (const SceneWear& sw : rigid_->wear()) csv_ << ',' << sw.surface->total_volume_m3();
+        }
+        const double now = wall_seconds_now();
+        const std::uint64_t steps = w.step_count() - row_step_;
+        csv_ << ',' << (row_step_ != ~0ull && steps > 0 ? (now - row_wall_s_) / static_cast<double>(steps) : 0.0) << ',' << now << '\n';
+        row_step_ = w.step_count();
+        row_wall_s_ = now;
         finish_writing(csv_, dir_ + "/probes.csv");
         last_row_step_ = w.step_count();
     }
@@ -278,11 +329,26 @@ private:
         particles_pvd_->add(world_->time_s(), file);
         for (std::size_t w = 0; w < wall_pvd_.size(); ++w) {
             if (!wall_pvd_[w]) continue;
-            const std::string name = "wall_" + world_->wall_name(static_cast<int>(w));
+            const std::string name = "wall_" + world_->wall_name(walls_[w]);
             const std::string mesh_file = numbered(name, snapshot_index_);
-            dem::write_mesh_vtp(world_->mesh_wall(static_cast<int>(w)), dir_ + "/" + mesh_file);
+            dem::write_mesh_vtp(world_->mesh_wall(walls_[w]), dir_ + "/" + mesh_file);
             wall_pvd_[w]->add(world_->time_s(), mesh_file);
         }
+        if (rocks_pvd_) {
+            const std::string rock_file = numbered("rocks", snapshot_index_);
+            rigid_->write_rocks_vtp(dir_ + "/" + rock_file);
+            rocks_pvd_->add(world_->time_s(), rock_file);
+        }
+        if (rigid_)
+            for (std::size_t k = 0; k < rigid_->wear().size(); ++k) {
+                const SceneWear& sw = rigid_->wear()[k];
+                const std::string wear_file = numbered("wear_" + sw.spec.part, snapshot_index_);
+                Mat3 r;
+                Vec3 o;
+                rigid_->wear_pose(sw, r, o);
+                wear::write_wear_vtp(*sw.surface, dir_ + "/" + wear_file, rigid_->tonnage_t(), sw.spec.smoothing_iterations, r, o);
+                wear_pvd_[k]->add(world_->time_s(), wear_file);
+            }
         ++snapshot_index_;
     }
 
@@ -291,8 +357,27 @@ private:
         return wall_seconds_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
     }
 
+    /// A PNG wear map (mm/t) of each wear surface seen from +z of its own frame (the dipper's bottom seen
+    /// from inside, a floor), once material has passed; a part with no face towards +z gets none.
+    void write_wear_maps()
+    {
+        if (!(rigid_->tonnage_t() > 0.0)) return;
+        for (const SceneWear& sw : rigid_->wear()) {
+            wear::MapView view;
+            // the dipper's bottom, seen from inside: its top plate's outside lies above it
+            if (sw.spec.part == "dipper") view.max_along_view_m = rigid_->dipper().parameters.height_m / 2.0;
+            try {
+                wear::write_wear_map_png(*sw.surface, dir_ + "/wear_" + sw.spec.part + "_map.png", rigid_->tonnage_t(),
+                                         sw.spec.smoothing_iterations, view);
+            } catch (const InputError&) {
+                // no triangle of the part faces +z: no map
+            }
+        }
+    }
+
     void checkpoint()
     {
+        if (rigid_) return;  // Bullet's state is not saved yet (docs/limits.md)
         StateWriter out;
         out.tag("run");
         out.text(scenario_.text);
@@ -320,7 +405,7 @@ private:
             }
         };
         write_entries(particles_pvd_.get());
-        for (const auto& w : wall_pvd_) write_entries(w.get());
+        for (std::size_t w = 0; w < world_->wall_count(); ++w) write_entries(wall_pvd_[w].get());
         // the new file first, then the old one becomes the previous: a good checkpoint always exists
         const fs::path dir(dir_);
         out.save((dir / "checkpoint.next.bin").string(), kCheckpointMagic);
@@ -370,9 +455,9 @@ private:
             << "  \"threads\": " << w.threads() << ",\n  \"particles\": " << w.particles().size() << ",\n"
             << "  \"mass_kg\": " << json_number(w.total_mass_kg()) << ",\n  \"kinetic_energy_J\": " << json_number(w.kinetic_energy_J()) << ",\n"
             << "  \"wall_forces_N\": {";
-        for (std::size_t k = 0; k < w.wall_count(); ++k) {
-            const Vec3 f = w.wall_force_N(static_cast<int>(k));
-            out << (k ? ", " : "") << "\"" << json_escape(w.wall_name(static_cast<int>(k))) << "\": [" << json_number(f.x) << ", "
+        for (std::size_t k = 0; k < walls_.size(); ++k) {
+            const Vec3 f = w.wall_force_N(walls_[k]);
+            out << (k ? ", " : "") << "\"" << json_escape(w.wall_name(walls_[k])) << "\": [" << json_number(f.x) << ", "
                 << json_number(f.y) << ", " << json_number(f.z) << "]";
         }
         out << "},\n  \"region_mass_kg\": {";
@@ -381,22 +466,59 @@ private:
         out << "},\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
-            << "  \"state_hash\": \"" << hash << "\"\n}\n";
+            << "  \"state_hash\": \"" << hash << "\"";
+        if (rigid_) write_rigid_summary(out);
+        out << "\n}\n";
         finish_writing(out, dir_ + "/summary.json");
+    }
+
+    void write_rigid_summary(std::ostream& out) const
+    {
+        const RigidScene& r = *rigid_;
+        out << ",\n  \"rocks\": " << r.coupled().rocks().size() << ",\n  \"rock_kinetic_energy_J\": " << json_number(r.rock_kinetic_energy_J());
+        if (r.has_shovel()) {
+            const BucketContents b = r.bucket();
+            out << ",\n  \"bucket_mass_kg\": " << json_number(b.mass_kg) << ",\n  \"fill_factor\": " << json_number(b.fill_factor)
+                << ",\n  \"passes\": [";
+            for (std::size_t k = 0; k < r.passes().size(); ++k) {
+                const PassRecord& p = r.passes()[k];
+                out << (k ? "," : "") << "\n    {\"pass\": " << k + 1 << ", \"start_s\": " << json_number(p.start_s)
+                    << ", \"dig_start_s\": " << json_number(p.dig_start_s) << ", \"dig_end_s\": " << json_number(p.dig_end_s) << ", \"dump_s\": " << json_number(p.dump_s)
+                    << ", \"mass_kg\": " << json_number(p.mass_kg) << ", \"fill_factor\": " << json_number(p.fill_factor)
+                    << ", \"mean_dig_force_N\": " << json_number(p.mean_dig_force_N)
+                    << ", \"peak_dig_force_N\": " << json_number(p.peak_dig_force_N) << "}";
+            }
+            out << (r.passes().empty() ? "]" : "\n  ]");
+        }
+        out << ",\n  \"tonnage_t\": " << json_number(r.tonnage_t()) << ",\n  \"wear\": {";
+        for (std::size_t k = 0; k < r.wear().size(); ++k) {
+            const SceneWear& w = r.wear()[k];
+            const std::vector<double> depth = w.surface->node_depth_m(w.spec.smoothing_iterations);
+            const double max_depth = depth.empty() ? 0.0 : *std::max_element(depth.begin(), depth.end());
+            out << (k ? ", " : "") << "\"" << json_escape(w.spec.part) << "\": {\"law\": \"" << w.spec.law
+                << "\", \"constant\": " << json_number(w.spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
+                << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth) << "}";
+        }
+        out << "}";
     }
 
     Scenario scenario_;
     std::string dir_;
     RunOptions options_;
     std::unique_ptr<dem::World> world_;
+    std::unique_ptr<RigidScene> rigid_;  ///< rocks, shovel and wear; null for spheres and walls only
+    std::vector<int> walls_;             ///< the walls outputs list
     std::vector<dem::Pourer> pourers_;
     std::unique_ptr<dem::PvdCollection> particles_pvd_;
     std::vector<std::unique_ptr<dem::PvdCollection>> wall_pvd_;
+    std::unique_ptr<dem::PvdCollection> rocks_pvd_;
+    std::vector<std::unique_ptr<dem::PvdCollection>> wear_pvd_;
     std::ofstream csv_;
     double next_csv_s_ = 0.0, next_vtk_s_ = 0.0, next_checkpoint_s_ = 0.0;
     int snapshot_index_ = 0;
     double wall_seconds_before_ = 0.0;
-    std::uint64_t steps_before_ = 0, last_row_step_ = ~0ull;
+    std::uint64_t steps_before_ = 0, last_row_step_ = ~0ull, row_step_ = ~0ull;
+    double row_wall_s_ = 0.0;
     std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now(), last_progress_;
 };
 
@@ -434,6 +556,14 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
         if (fs::exists(dir / "checkpoint.next.bin") || fs::exists(dir / "checkpoint.prev.bin"))
             hint = concat("; try --from ", fs::exists(dir / "checkpoint.next.bin") ? (dir / "checkpoint.next.bin").string()
                                                                                    : (dir / "checkpoint.prev.bin").string());
+        if (hint.empty() && fs::exists(dir / "scenario.yaml")) {
+            bool coupled = false;
+            try {
+                coupled = load_scenario((dir / "scenario.yaml").string()).uses_coupling();
+            } catch (const InputError&) {
+            }
+            if (coupled) hint = "; runs with rocks, a shovel or wear write no checkpoints yet, so this run cannot be resumed";
+        }
         throw InputError(concat("no checkpoint '", path, "' to resume from", hint));
     }
     std::unique_ptr<StateReader> in;
@@ -449,6 +579,7 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
     const std::string text = in->text(), source = in->text(), base_dir = in->text();
     const int threads = in->value<std::int32_t>();
     Scenario scenario = parse_scenario(text, source, base_dir);
+    DIPPER_ASSERT(!scenario.uses_coupling(), "a checkpoint of a coupled run");
     RunOptions o = options;
     if (o.threads <= 0) o.threads = threads;  // same thread count, same bits
     Run run(std::move(scenario), out_dir, o);

@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "meshes/mesh_io.h"
 #include "scenario/keys.h"
+#include "wear/laws.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -220,7 +221,7 @@ private:
     YAML::Mark mark_;
 };
 
-dem::SizeDistribution read_sizes(const MapReader& r)
+dem::SizeDistribution read_sizes(const MapReader& r, bool fractions_sum_to_one = true)
 {
     dem::SizeDistribution d;
     for (const MapReader& s : r.maps("sizes")) {
@@ -230,7 +231,7 @@ dem::SizeDistribution read_sizes(const MapReader& r)
         d.classes.push_back({radius, fraction});
     }
     if (d.classes.empty()) r.fail("sizes", "an empty list", "at least one size class");
-    d.validate(r.where("sizes"));
+    if (fractions_sum_to_one) d.validate(r.where("sizes"));
     return d;
 }
 
@@ -310,7 +311,7 @@ std::string material_known(const Scenario& s, const MapReader& r, const std::str
 }
 
 /// The keys fills and pours share: material, mass, box and sizes.
-ParticleSource read_source(const Scenario& s, const MapReader& r)
+ParticleSource read_source(const Scenario& s, const MapReader& r, bool fractions_sum_to_one = true)
 {
     ParticleSource source;
     source.where = r.where("mass_kg");
@@ -318,8 +319,67 @@ ParticleSource read_source(const Scenario& s, const MapReader& r)
     source.mass_kg = r.number("mass_kg");
     require_positive(source.mass_kg, "mass_kg", r.where("mass_kg"));
     read_box(r.map("box"), source.min_m, source.max_m, "min_m", "max_m");
-    source.sizes = read_sizes(r);
+    source.sizes = read_sizes(r, fractions_sum_to_one);
     return source;
+}
+
+FillSpec read_fill(const Scenario& s, const MapReader& r)
+{
+    FillSpec fill;
+    const std::vector<MapReader> rocks = r.maps("rocks");
+    static_cast<ParticleSource&>(fill) = read_source(s, r, rocks.empty());
+    fill.rock_elongation_max = r.number("rock_elongation_max");
+    require_in_range(fill.rock_elongation_max, 1.0, 4.0, "rock_elongation_max", r.where("rock_elongation_max"));
+    if (rocks.empty()) return fill;
+    if (fill.sizes.classes.size() != 1)
+        r.fail("sizes", concat(fill.sizes.classes.size(), " sphere classes"), "one sphere class in a fill with rocks");
+    double sum = fill.sizes.classes[0].mass_fraction;
+    for (const MapReader& k : rocks) {
+        RockClassSpec c;
+        c.size_m = k.number("size_m");
+        require_positive(c.size_m, "size_m", k.where("size_m"));
+        c.mass_fraction = k.number("mass_fraction");
+        require_in_range(c.mass_fraction, 0.0, 1.0, "mass_fraction", k.where("mass_fraction"));
+        sum += c.mass_fraction;
+        fill.rocks.push_back(c);
+    }
+    if (std::abs(sum - 1.0) > 1e-6)
+        r.fail("rocks", concat("mass fractions summing to ", sum, " with the spheres'"),
+               "the sphere class and the rock classes to sum to 1");
+    return fill;
+}
+
+ShovelSpec read_shovel(const Scenario& s, const MapReader& m)
+{
+    ShovelSpec sh;
+    sh.where = s.source;
+    sh.position_m = m.vector3("position_m");
+    sh.heading_deg = m.number("heading_deg");
+    sh.rake_angle_deg = m.number("rake_angle_deg");
+    require_in_range(sh.rake_angle_deg, 40.0, 80.0, "rake_angle_deg", m.where("rake_angle_deg"));
+    sh.wear_bars = m.text("wear_bars");
+    if (sh.wear_bars != "baseline" && sh.wear_bars != "transverse" && sh.wear_bars != "diagonal")
+        m.fail("wear_bars", concat("\"", sh.wear_bars, "\""), "baseline, transverse or diagonal");
+    sh.element_size_m = m.number("element_size_m");
+    require_in_range(sh.element_size_m, 0.02, 1.0, "element_size_m", m.where("element_size_m"));
+    sh.material = material_known(s, m, "material", true);
+    sh.motion = m.text("motion");
+    if (sh.motion != "default_cycle") {
+        const std::filesystem::path file = std::filesystem::path(sh.motion).is_absolute()
+                                               ? std::filesystem::path(sh.motion)
+                                               : std::filesystem::path(s.base_dir) / sh.motion;
+        sh.motion = file.string();
+    }
+    sh.start_s = m.number("start_s");
+    require_non_negative(sh.start_s, "start_s", m.where("start_s"));
+    sh.dig_speed_factor = m.number("dig_speed_factor");
+    require_in_range(sh.dig_speed_factor, 0.5, 2.0, "dig_speed_factor", m.where("dig_speed_factor"));
+    if (sh.dig_speed_factor != 1.0 && m.text("motion") != "default_cycle")
+        m.fail("dig_speed_factor", concat(sh.dig_speed_factor), "1 with a motion file (the factor reshapes the default cycle only)");
+    sh.bulk_density_kg_per_m3 = m.number("bulk_density_kg_per_m3");
+    require_positive(sh.bulk_density_kg_per_m3, "bulk_density_kg_per_m3", m.where("bulk_density_kg_per_m3"));
+    sh.where = m.where("motion");
+    return sh;
 }
 
 }  // namespace
@@ -400,7 +460,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
                     throw InputError(concat(s.source, ": wall name '", names[a], "' is used twice; planes and meshes need unique names"));
     }
 
-    for (const MapReader& f : top.maps("fills")) s.fills.push_back(read_source(s, f));
+    for (const MapReader& f : top.maps("fills")) s.fills.push_back(read_fill(s, f));
     for (const MapReader& p : top.maps("pours")) {
         PourSpec pour;
         static_cast<ParticleSource&>(pour) = read_source(s, p);
@@ -411,6 +471,38 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     }
     if (s.fills.empty() && s.pours.empty())
         throw InputError(concat(s.source, ": the scenario has no particles; add a 'fills' or a 'pours' entry"));
+
+    const MapReader coupling = top.map("coupling");
+    const std::int64_t substeps = coupling.integer("substeps");
+    if (substeps < 1 || substeps > 100) coupling.fail("substeps", concat(substeps), "a whole number of DEM steps per rigid step, 1 to 100");
+    s.coupling_substeps = static_cast<int>(substeps);
+    if (top.has("shovel")) s.shovel = read_shovel(s, top.map("shovel"));
+    for (const MapReader& w : top.maps("wear")) {
+        WearSpec spec;
+        spec.where = w.where("part");
+        spec.part = w.text("part");
+        bool known = (spec.part == "dipper" || spec.part == "door") && s.shovel.has_value();
+        std::vector<std::string> parts;
+        if (s.shovel) parts = {"dipper", "door"};
+        for (const MeshSpec& mesh : s.meshes) {
+            parts.push_back(mesh.name);
+            known = known || mesh.name == spec.part;
+        }
+        if (!known)
+            w.fail("part", concat("\"", spec.part, "\""),
+                   parts.empty() ? std::string("a machine part, but the scenario has no shovel and no mesh walls")
+                                 : concat("one of the parts: ", joined(parts)));
+        for (const WearSpec& other : s.wear)
+            if (other.part == spec.part) w.fail("part", concat("\"", spec.part, "\""), "each part once in the wear list");
+        spec.law = w.text("law");
+        spec.constant = w.number("constant");
+        require_positive(spec.constant, "constant", w.where("constant"));
+        (void)wear::WearLaw::from_name(spec.law, spec.constant, w.where("law"));  // an unknown law names its key
+        const std::int64_t it = w.integer("smoothing_iterations");
+        if (it < 0 || it > 100) w.fail("smoothing_iterations", concat(it), "0 to 100");
+        spec.smoothing_iterations = static_cast<int>(it);
+        s.wear.push_back(spec);
+    }
 
     const MapReader probes = top.map("probes");
     for (const MapReader& r : probes.maps("regions")) {
@@ -430,6 +522,14 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     s.output.progress_interval_s = out.number("progress_interval_s");
     require_positive(s.output.progress_interval_s, "progress_interval_s", out.where("progress_interval_s"));
     return s;
+}
+
+bool Scenario::uses_coupling() const
+{
+    if (shovel || !wear.empty()) return true;
+    for (const FillSpec& f : fills)
+        if (!f.rocks.empty()) return true;
+    return false;
 }
 
 Scenario load_scenario(const std::string& path)
@@ -476,6 +576,9 @@ void check_pairs(const Scenario& s)
     std::vector<std::string> others = particle_materials;
     for (const auto& p : s.planes) others.push_back(p.material);
     for (const auto& m : s.meshes) others.push_back(m.material);
+    if (s.shovel) others.push_back(s.shovel->material);
+    for (const auto& f : s.fills)
+        if (!f.rocks.empty()) others.push_back("rock");  // the DEM material spheres see on rocks
     for (const std::string& a : particle_materials)
         for (const std::string& b : others)
             if (!s.materials.has_pair(s.materials.index_of(a), s.materials.index_of(b)))
@@ -523,6 +626,7 @@ void build_particles(const Scenario& s, dem::World& world)
 {
     for (std::size_t k = 0; k < s.fills.size(); ++k) {
         const FillSpec& f = s.fills[k];
+        if (!f.rocks.empty()) continue;
         try {
             dem::fill_random(world, ClearOfWalls(f.min_m, f.max_m, world), f.sizes, s.materials.index_of(f.material), f.mass_kg,
                              s.seed * 1000003ull + k);

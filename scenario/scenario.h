@@ -38,7 +38,16 @@ struct ParticleSource {
     std::string where;  ///< file:line:col of the entry's mass_kg, for errors found when placing
 };
 
-using FillSpec = ParticleSource;
+/// One class of polyhedral rocks in a fill.
+struct RockClassSpec {
+    double size_m = 0.0, mass_fraction = 0.0;
+};
+
+/// Particles placed at t = 0: spheres only, or spheres of one size with rock classes (a mixed fill).
+struct FillSpec : ParticleSource {
+    std::vector<RockClassSpec> rocks;
+    double rock_elongation_max = 2.0;
+};
 
 struct PourSpec : ParticleSource {
     double rate_kg_per_s = 0.0;
@@ -48,6 +57,29 @@ struct PourSpec : ParticleSource {
 struct RegionProbe {
     std::string name;
     Vec3 min_m, max_m;
+};
+
+/// The rope shovel of a scenario (rigid/rope_shovel.h).
+struct ShovelSpec {
+    Vec3 position_m;
+    double heading_deg = 0.0;
+    double rake_angle_deg = 61.8;
+    std::string wear_bars = "baseline";  ///< baseline (no bars), transverse, diagonal
+    double element_size_m = 0.15;
+    std::string material = "bucket";
+    std::string motion = "default_cycle";  ///< or a CSV file, absolute or relative to base_dir
+    double start_s = 0.0;
+    double dig_speed_factor = 1.0;
+    double bulk_density_kg_per_m3 = 1903.0;
+    std::string where;
+};
+
+/// A wear surface on a machine part.
+struct WearSpec {
+    std::string part, law;
+    double constant = 0.0;
+    int smoothing_iterations = 2;
+    std::string where;
 };
 
 struct OutputSpec {
@@ -71,6 +103,13 @@ struct Scenario {
     std::vector<PourSpec> pours;
     std::vector<RegionProbe> regions;
     OutputSpec output;
+    int coupling_substeps = 5;
+    std::optional<ShovelSpec> shovel;
+    std::vector<WearSpec> wear;
+
+    /// True if the run goes through the coupling (scenario/rigid_scene.h): it has rocks, the shovel or
+    /// wear surfaces.
+    bool uses_coupling() const;
 };
 
 /// Reads and checks a scenario file. Errors are InputErrors of the form
@@ -85,8 +124,8 @@ std::unique_ptr<dem::World> build_world(const Scenario& scenario);
 /// Checks that every particle material of the fills and pours has coefficients with every other one and
 /// with every wall's material; throws an InputError naming the pair and the scenario otherwise.
 void check_pairs(const Scenario& scenario);
-/// Places the fills' particles (seeded by the scenario's seed and the fill's position in the list), clear
-/// of the walls.
+/// Places the particles of the fills without rocks (seeded by the scenario's seed and the fill's position
+/// in the list), clear of the walls. Fills with rocks are placed by RigidScene::fill_mixed.
 void build_particles(const Scenario& scenario, dem::World& world);
 /// The pours, ready to run from t = 0.
 std::vector<dem::Pourer> make_pourers(const Scenario& scenario, const dem::World& world);

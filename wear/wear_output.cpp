@@ -73,8 +73,11 @@ MapPicture write_wear_map_png(const WearSurface& s, const std::string& path, dou
     const auto& mesh = s.mesh();
     const double cos_max = std::cos(view.max_angle_deg * M_PI / 180.0);
     std::vector<std::size_t> shown;
-    for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
-        if (dot(mesh.triangle_normal(t), d) >= cos_max) shown.push_back(t);
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const auto& tri = mesh.triangles()[t];
+        const Vec3 centroid = (mesh.vertices_m()[tri[0]] + mesh.vertices_m()[tri[1]] + mesh.vertices_m()[tri[2]]) * (1.0 / 3.0);
+        if (dot(mesh.triangle_normal(t), d) >= cos_max && dot(centroid, d) <= view.max_along_view_m) shown.push_back(t);
+    }
     if (shown.empty())
         throw InputError(concat("wear map '", path, "': no triangle of '", s.name(), "' faces the viewer within ",
                                 view.max_angle_deg, " deg"));

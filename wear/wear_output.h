@@ -4,6 +4,7 @@
 
 #include "wear/wear_surface.h"
 
+#include <limits>
 #include <string>
 
 namespace dipper::wear {
@@ -23,6 +24,9 @@ struct MapView {
     Vec3 right{1.0, 0.0, 0.0};
     double max_angle_deg = 30.0;
     int width_px = 900;
+    /// Triangles whose centroid lies farther towards the viewer than this (dot(centroid, toward_viewer),
+    /// toward_viewer normalised) are left out: the outside of a top plate hides the bottom under it.
+    double max_along_view_m = std::numeric_limits<double>::infinity();
 };
 
 struct MapPicture {

@@ -89,12 +89,15 @@ std::string summary_value(const std::string& dir, const std::string& key)
     return m[1];
 }
 
-/// probes.csv without its last column (wall-clock seconds, which no two runs share).
+/// probes.csv without its last two columns (wall-clock seconds per step and in all, which no two runs share).
 std::string probes_without_clock(const std::string& dir)
 {
     std::istringstream in(read_file(dir + "/probes.csv"));
     std::string line, out;
-    while (std::getline(in, line)) out += line.substr(0, line.rfind(',')) + "\n";
+    while (std::getline(in, line)) {
+        line = line.substr(0, line.rfind(','));
+        out += line.substr(0, line.rfind(',')) + "\n";
+    }
     return out;
 }
 

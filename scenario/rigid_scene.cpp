@@ -1,0 +1,316 @@
+#include "scenario/rigid_scene.h"
+
+#include "core/errors.h"
+#include "coupling/mixed_bed.h"
+#include "meshes/vtk_surface.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dipper::scenario {
+
+namespace {
+
+/// The default cycle with each pass's dig (its first 15 s) done `factor` times faster; what follows the
+/// dig keeps its duration, so a pass lasts 31 s + 15 s / factor.
+rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor)
+{
+    if (factor == 1.0) return cycle;
+    constexpr double pass = 46.0, dig = 15.0;
+    const double new_pass = pass - dig + dig / factor;
+    std::vector<rigid::MotionSample> samples = cycle.samples();
+    for (rigid::MotionSample& s : samples) {
+        const double k = std::floor(s.time_s / pass + 1e-9);
+        const double local = s.time_s - k * pass;
+        s.time_s = k * new_pass + (local <= dig ? local / factor : local - dig + dig / factor);
+    }
+    return rigid::MotionCurves::from_samples(std::move(samples),
+                                             concat("default three-pass loading cycle, dig ", factor, " times as fast"));
+}
+
+/// A large square of two triangles in a plane, for Bullet (which has a ground plane only for z = const).
+meshes::TriangleMesh plane_patch(const Vec3& point, const Vec3& normal, double half_size_m)
+{
+    const Vec3 helper = std::abs(normal.z) < 0.9 ? Vec3{0, 0, 1} : Vec3{1, 0, 0};
+    const Vec3 u = normalized(cross(helper, normal)), v = cross(normal, u);
+    const std::vector<Vec3> x{point + (u + v) * -half_size_m, point + (u - v) * half_size_m, point + (u + v) * half_size_m,
+                              point + (v - u) * half_size_m};
+    return meshes::TriangleMesh(x, {{0, 1, 2}, {0, 2, 3}}, "plane");
+}
+
+int rigid_material_or_none(const rigid::RigidWorld& w, const std::string& name)
+{
+    try {
+        return w.material_index(name);
+    } catch (const InputError&) {
+        return -1;
+    }
+}
+
+}  // namespace
+
+RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
+{
+    scenario_walls_ = dem.wall_count();
+    rigid::RigidSettings settings;
+    settings.gravity_m_per_s2 = s.gravity_m_per_s2;
+    rigid_ = std::make_unique<rigid::RigidWorld>(settings);
+    rigid::add_aitik_copper_ore_materials(*rigid_);
+    coupled_ = std::make_unique<coupling::CoupledWorld>(dem, *rigid_, coupling::CouplingSettings{s.coupling_substeps});
+    bool rocks = false;
+    for (const FillSpec& f : s.fills) rocks = rocks || !f.rocks.empty();
+
+    // the walls in Bullet, for rocks and the dipper; a wall whose material Bullet lacks is an error only
+    // where rocks could meet it
+    const auto rigid_material = [&](const std::string& wall, const std::string& material) {
+        const int m = rigid_material_or_none(*rigid_, material);
+        if (m < 0 && rocks)
+            throw InputError(concat(s.source, ": rocks meet wall '", wall, "' of material '", material,
+                                    "', which has no rock coefficients in the rigid world; give it one of the rigid materials "
+                                    "rock, ground, bucket"));
+        return m;
+    };
+    for (const PlaneSpec& p : s.planes) {
+        const int m = rigid_material(p.name, p.material);
+        if (m < 0) continue;
+        if (p.normal.z > 1.0 - 1e-12) rigid_->add_ground_plane(p.point_m.z, m, p.name);
+        else rigid_->add_static_mesh(plane_patch(p.point_m, p.normal, 500.0), m, p.name);
+    }
+    for (std::size_t k = 0; k < s.meshes.size(); ++k) {
+        const MeshSpec& spec = s.meshes[k];
+        if (spec.motion) {
+            if (rocks)
+                throw InputError(concat(spec.where, ": mesh wall '", spec.name,
+                                        "' moves, and rocks do not yet collide with moving mesh walls; "
+                                        "use spheres only, or a fixed wall"));
+            continue;
+        }
+        const int m = rigid_material(spec.name, spec.material);
+        if (m < 0) continue;
+        const int wall = static_cast<int>(s.planes.size() + k);
+        static_meshes_.emplace_back(spec.name, rigid_->add_static_mesh(dem.mesh_wall(wall).mesh(), m, spec.name));
+    }
+
+    if (s.shovel) {
+        const ShovelSpec& sh = *s.shovel;
+        meshes::DipperParameters p;
+        p.rake_angle_deg = sh.rake_angle_deg;
+        p.element_size_m = sh.element_size_m;
+        p.wear_bars = sh.wear_bars == "transverse" ? meshes::WearBars::Transverse
+                      : sh.wear_bars == "diagonal" ? meshes::WearBars::Diagonal
+                                                   : meshes::WearBars::None;
+        try {
+            dipper_ = meshes::make_dipper(p);
+        } catch (const InputError& e) {
+            throw InputError(concat(sh.where, ": ", e.what()));
+        }
+        const rigid::ShovelGeometry geometry;
+        rigid::MotionCurves motion = sh.motion == "default_cycle"
+                                         ? dig_speed_scaled(rigid::default_loading_cycle(geometry, dipper_), sh.dig_speed_factor)
+                                         : rigid::MotionCurves::from_csv(sh.motion);
+        if (sh.start_s > 0.0) {
+            std::vector<rigid::MotionSample> samples = motion.samples();
+            for (rigid::MotionSample& m : samples) m.time_s += sh.start_s;
+            motion = rigid::MotionCurves::from_samples(std::move(samples), concat(motion.source(), ", from t = ", sh.start_s, " s"));
+        }
+        bulk_density_ = sh.bulk_density_kg_per_m3;
+        motion_ = std::make_unique<rigid::MotionCurves>(motion);
+        const rigid::RigidWorld::ShovelParts parts =
+            rigid_->add_rope_shovel(dipper_, geometry, std::move(motion), rigid_->material_index("bucket"), sh.position_m, sh.heading_deg);
+        dipper_body_ = parts.dipper;
+        door_body_ = parts.door;
+        const dem::MaterialIndex steel = dem.materials().index_of(sh.material);
+        dipper_wall_ = coupled_->body(coupled_->couple(parts.dipper, dipper_.body.surface, steel, "dipper")).wall;
+        door_wall_ = coupled_->body(coupled_->couple(parts.door, dipper_.door.surface, steel, "door")).wall;
+    }
+}
+
+RigidScene::~RigidScene() = default;
+
+void RigidScene::fill_mixed(const Scenario& s)
+{
+    const dem::MaterialTable& table = dem_->materials();
+    for (std::size_t k = 0; k < s.fills.size(); ++k) {
+        const FillSpec& f = s.fills[k];
+        if (f.rocks.empty()) continue;
+        coupling::MixedDistribution d;
+        d.sphere_radius_m = f.sizes.classes[0].radius_m;
+        d.sphere_mass_fraction = f.sizes.classes[0].mass_fraction;
+        d.rocks.clear();
+        for (const RockClassSpec& c : f.rocks) d.rocks.push_back({c.size_m, c.mass_fraction});
+        d.elongation_max = f.rock_elongation_max;
+        try {
+            const dem::MaterialIndex sphere = table.index_of(f.material);
+            const dem::MaterialIndex rock = table.index_of("rock");
+            const coupling::MixedMaterials m{sphere, rock, rigid_->material_index("rock"), table.material(sphere).density_kg_per_m3};
+            coupling::fill_mixed(*coupled_, f.min_m, f.max_m, d, m, f.mass_kg, s.seed * 1000003ull + k);
+        } catch (const InputError& e) {
+            throw InputError(concat(f.where, ": ", e.what()));
+        }
+    }
+}
+
+void RigidScene::add_wear(const Scenario& s)
+{
+    for (const WearSpec& spec : s.wear) {
+        SceneWear w;
+        w.spec = spec;
+        meshes::TriangleMesh mesh;
+        if (spec.part == "dipper" || spec.part == "door") {
+            const bool d = spec.part == "dipper";
+            mesh = d ? dipper_.body.surface : dipper_.door.surface;
+            w.wall = d ? dipper_wall_ : door_wall_;
+            w.body = d ? dipper_body_ : door_body_;
+        } else {
+            for (std::size_t k = 0; k < s.meshes.size(); ++k)
+                if (s.meshes[k].name == spec.part) w.wall = static_cast<int>(s.planes.size() + k);
+            DIPPER_ASSERT(w.wall >= 0, "wear part checked by the parser");
+            mesh = dem_->mesh_wall(w.wall).mesh();
+            for (const auto& [name, body] : static_meshes_)
+                if (name == spec.part) w.body = body;
+        }
+        w.surface = std::make_unique<wear::WearSurface>(spec.part, std::move(mesh),
+                                                        wear::WearLaw::from_name(spec.law, spec.constant, spec.where), w.wall);
+        wear_.push_back(std::move(w));
+    }
+    if (!wear_.empty())
+        coupled_->dem().set_contact_consumer([this](const std::vector<ContactRecord>& records, double, double dt) {
+            for (SceneWear& w : wear_) w.surface->accumulate(records, dt);
+        });
+}
+
+void RigidScene::step()
+{
+    coupled_->step();
+    const double dt = coupled_->coupling_step_s();
+    for (SceneWear& w : wear_)
+        if (w.body >= 0)
+            for (const ContactRecord& r : rigid_->surface_contacts(w.body, w.wall, &w.surface->mesh())) w.surface->add_contact(r, dt);
+    track_passes();
+}
+
+const rigid::ShovelReading& RigidScene::reading() const
+{
+    return rigid_->shovel_reading();
+}
+
+BucketContents RigidScene::bucket() const
+{
+    BucketContents b;
+    if (!has_shovel()) return b;
+    Mat3 r;
+    Vec3 o;
+    rigid_->dipper_pose(r, o);
+    const Mat3 back = r.transposed();
+    const meshes::DipperParameters& p = dipper_.parameters;
+    const auto inside = [&](const Vec3& x) {
+        const Vec3 q = back * (x - o);
+        if (q.x < 0.0 || q.z < 0.0 || q.z > p.height_m || std::abs(q.y) > p.width_m / 2.0) return false;
+        // the struck plane from the lip (bottom_length, 0) to the top plate's front edge (top_length, H)
+        return q.x <= p.bottom_length_m + (p.top_length_m - p.bottom_length_m) * q.z / p.height_m;
+    };
+    const dem::ParticleStore& s = dem_->particles();
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (inside(s.position_m[i])) {
+            b.mass_kg += s.mass_kg[i];
+            ++b.spheres;
+        }
+    for (const coupling::RockRecord& rock : coupled_->rocks())
+        if (inside(rigid_->state(rock.body).position_m)) {
+            b.mass_kg += rigid_->mass_kg(rock.body);
+            ++b.rocks;
+        }
+    b.fill_factor = b.mass_kg / (bulk_density_ * dipper_.struck_volume_m3);
+    return b;
+}
+
+void RigidScene::track_passes()
+{
+    if (!has_shovel()) return;
+    const rigid::ShovelReading& r = reading();
+    const double t = coupled_->time_s(), dt = coupled_->coupling_step_s();
+    // the dig phase: the swing at rest, the door shut, and the hoist rope being hauled in
+    const rigid::MotionSample now = motion_->at(t), before = motion_->at(t - dt);
+    const bool hauling = now.hoist_length_m < before.hoist_length_m;
+    if (!door_open_ && std::abs(now.swing_deg) < 2.0 && now.door_deg < 1.0 && hauling) {
+        dig_force_sum_ += r.dig_force_N;
+        dig_force_peak_ = std::max(dig_force_peak_, r.dig_force_N);
+        if (dig_samples_++ == 0) dig_start_s_ = t;
+        dig_end_s_ = t;
+    }
+    if (!door_open_ && r.door_deg > 5.0) {
+        door_open_ = true;
+        const BucketContents b = bucket();
+        PassRecord pass;
+        pass.start_s = pass_start_s_;
+        pass.dig_start_s = dig_start_s_;
+        pass.dig_end_s = dig_end_s_;
+        pass.dump_s = t;
+        pass.mass_kg = b.mass_kg;
+        pass.fill_factor = b.fill_factor;
+        pass.mean_dig_force_N = dig_samples_ > 0 ? dig_force_sum_ / static_cast<double>(dig_samples_) : 0.0;
+        pass.peak_dig_force_N = dig_force_peak_;
+        passes_.push_back(pass);
+    }
+    if (door_open_ && r.door_deg < 1.0) {
+        door_open_ = false;
+        pass_start_s_ = t;
+        dig_force_sum_ = dig_force_peak_ = 0.0;
+        dig_samples_ = 0;
+        dig_start_s_ = dig_end_s_ = -1.0;
+    }
+}
+
+double RigidScene::tonnage_t() const
+{
+    double kg = 0.0;
+    for (const PassRecord& p : passes_) kg += p.mass_kg;
+    return kg / 1000.0;
+}
+
+void RigidScene::wear_pose(const SceneWear& w, Mat3& rotation, Vec3& origin_m) const
+{
+    if (w.body >= 0 && rigid_->is_dynamic(w.body)) {
+        rigid_->part_pose(w.body, rotation, origin_m);
+        return;
+    }
+    const dem::MeshWall& wall = dem_->mesh_wall(w.wall);
+    rotation = wall.rotation();
+    origin_m = wall.translation_m();
+}
+
+std::vector<int> RigidScene::listed_walls() const
+{
+    std::vector<int> walls;
+    for (std::size_t w = 0; w < scenario_walls_; ++w) walls.push_back(static_cast<int>(w));
+    if (dipper_wall_ >= 0) walls.push_back(dipper_wall_);
+    if (door_wall_ >= 0) walls.push_back(door_wall_);
+    return walls;
+}
+
+bool RigidScene::is_rock_wall(int wall) const
+{
+    return wall >= static_cast<int>(scenario_walls_) && wall != dipper_wall_ && wall != door_wall_;
+}
+
+void RigidScene::write_rocks_vtp(const std::string& path) const
+{
+    std::vector<Vec3> x;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<double> index, speed, size;
+    for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
+        const coupling::RockRecord& rock = coupled_->rocks()[k];
+        const rigid::BodyState st = rigid_->state(rock.body);
+        const auto first = static_cast<std::uint32_t>(x.size());
+        for (const Vec3& v : rock.shape.vertices_m()) x.push_back(st.rotation * v + st.position_m);
+        for (const auto& t : rock.shape.triangles()) {
+            triangles.push_back({first + t[0], first + t[1], first + t[2]});
+            index.push_back(static_cast<double>(k));
+            speed.push_back(norm(st.velocity_m_per_s));
+            size.push_back(rock.shape.equivalent_diameter_m());
+        }
+    }
+    meshes::write_surface_vtp(path, x, triangles, {}, {{"rock", index}, {"speed_m_per_s", speed}, {"size_m", size}});
+}
+
+}  // namespace dipper::scenario

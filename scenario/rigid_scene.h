@@ -1,0 +1,107 @@
+// The rigid side of a scenario: rocks and the rope shovel in Bullet, coupled to the DEM world, with the
+// wear surfaces and the shovel's probes (mass in the dipper, fill factor, drive forces, passes).
+#pragma once
+
+#include "coupling/coupled_world.h"
+#include "meshes/machine_geometry.h"
+#include "rigid/motion_curves.h"
+#include "rigid/rigid_world.h"
+#include "scenario/scenario.h"
+#include "wear/wear_surface.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dipper::scenario {
+
+/// One pass of the shovel: from the end of the previous dump (or t = 0) to the moment its door opens.
+struct PassRecord {
+    double start_s = 0.0;
+    double dig_start_s = -1.0;       ///< the dig phase: the swing at rest, the door shut, the hoist hauling in
+    double dig_end_s = -1.0;         ///< (its first and last step in this pass; -1 if there was none)
+    double dump_s = 0.0;             ///< the door passed 5 deg open
+    double mass_kg = 0.0;            ///< material in the dipper when the door opened
+    double fill_factor = 0.0;        ///< that mass / (bulk density x struck volume)
+    double mean_dig_force_N = 0.0;   ///< mean of sqrt(F_crowd^2 + F_hoist^2) over the dig phase (thesis eq. 11)
+    double peak_dig_force_N = 0.0;
+};
+
+/// What the dipper holds now.
+struct BucketContents {
+    double mass_kg = 0.0;
+    double fill_factor = 0.0;
+    std::size_t spheres = 0, rocks = 0;
+};
+
+/// A wear surface of a scenario with where its contacts come from.
+struct SceneWear {
+    WearSpec spec;
+    std::unique_ptr<wear::WearSurface> surface;
+    int wall = -1;              ///< DEM wall whose sphere contacts it sums
+    rigid::BodyId body = -1;    ///< Bullet body whose rock contacts it sums (-1: none)
+};
+
+class RigidScene {
+public:
+    /// Builds Bullet's side for `scenario` around `dem` (its planes and meshes already added): the walls
+    /// rocks touch, the shovel with dipper and door coupled to the spheres, and the coupling itself.
+    RigidScene(const Scenario& scenario, dem::World& dem);
+    ~RigidScene();
+    RigidScene(const RigidScene&) = delete;
+    RigidScene& operator=(const RigidScene&) = delete;
+
+    /// Places the fills that have rocks (the others go through build_particles).
+    void fill_mixed(const Scenario& scenario);
+    /// Sets up the wear surfaces; call after the fills.
+    void add_wear(const Scenario& scenario);
+
+    /// One coupling step (substeps DEM steps), wear and passes included.
+    void step();
+
+    coupling::CoupledWorld& coupled() { return *coupled_; }
+    const coupling::CoupledWorld& coupled() const { return *coupled_; }
+    rigid::RigidWorld& rigid() { return *rigid_; }
+    const rigid::RigidWorld& rigid() const { return *rigid_; }
+
+    bool has_shovel() const { return dipper_body_ >= 0; }
+    const meshes::Dipper& dipper() const { return dipper_; }
+    const rigid::ShovelReading& reading() const;
+    BucketContents bucket() const;
+    const std::vector<PassRecord>& passes() const { return passes_; }
+    /// Mass carried out of the dipper so far: the sum of the passes' masses, t.
+    double tonnage_t() const;
+    const std::vector<SceneWear>& wear() const { return wear_; }
+    /// Pose of a wear surface's mesh frame in the world now.
+    void wear_pose(const SceneWear& w, Mat3& rotation, Vec3& origin_m) const;
+
+    /// The DEM walls that are machine parts or scenario walls (not rock hulls), for outputs.
+    std::vector<int> listed_walls() const;
+    bool is_rock_wall(int wall) const;
+    /// Every rock as one ParaView surface: triangles of each hull with cell fields rock (index),
+    /// speed_m_per_s and size_m.
+    void write_rocks_vtp(const std::string& path) const;
+    double rock_kinetic_energy_J() const { return rigid_->kinetic_energy_J(); }
+
+private:
+    void track_passes();
+
+    const dem::World* dem_ = nullptr;
+    std::unique_ptr<rigid::RigidWorld> rigid_;
+    std::unique_ptr<coupling::CoupledWorld> coupled_;
+    meshes::Dipper dipper_;
+    std::unique_ptr<rigid::MotionCurves> motion_;  ///< the shovel's curves (the dig phase is read from them)
+    double bulk_density_ = 1903.0;
+    rigid::BodyId dipper_body_ = -1, door_body_ = -1;
+    int dipper_wall_ = -1, door_wall_ = -1;
+    std::vector<std::pair<std::string, rigid::BodyId>> static_meshes_;  ///< scenario mesh name, Bullet body
+    std::size_t scenario_walls_ = 0;  ///< DEM walls 0 .. n-1 are the scenario's planes and meshes
+    std::vector<SceneWear> wear_;
+    std::vector<PassRecord> passes_;
+    // pass tracking
+    bool digging_ = true, door_open_ = false;
+    double pass_start_s_ = 0.0, dig_start_s_ = -1.0, dig_end_s_ = -1.0, dig_force_sum_ = 0.0, dig_force_peak_ = 0.0;
+    std::uint64_t dig_samples_ = 0;
+};
+
+}  // namespace dipper::scenario

@@ -1,0 +1,74 @@
+"""Reads what `dipper run tests/data/scenarios/machine_small.yaml` wrote (rocks, shovel, wear) with VTK's
+XML readers and Python's csv and json, and checks the arrays, their sizes and the probe columns.
+Usage: read_machine_output.py DIR"""
+import csv
+import json
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+import vtk
+
+folder = sys.argv[1]
+summary = json.load(open(os.path.join(folder, "summary.json")))
+assert summary["status"] == "completed", summary
+assert summary["rocks"] > 10, summary["rocks"]
+assert summary["passes"] == [], summary["passes"]
+assert "dipper" in summary["wear"] and summary["wear"]["dipper"]["law"] == "force_work", summary["wear"]
+
+
+def frames(pvd):
+    return ET.parse(os.path.join(folder, pvd)).getroot().findall("./Collection/DataSet")
+
+
+def read(file):
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(os.path.join(folder, file))
+    reader.Update()
+    return reader.GetOutput()
+
+
+with open(os.path.join(folder, "probes.csv")) as f:
+    rows = list(csv.DictReader(f))
+for column in ("rocks", "rock_kinetic_energy_J", "bucket_mass_kg", "fill_factor", "crowd_force_N", "hoist_force_N",
+               "dig_force_N", "swing_deg", "door_deg", "tooth_tip_z_m", "wear_dipper_m3", "force_dipper_z_N",
+               "force_door_z_N", "wall_s_per_step"):
+    assert column in rows[0], f"probes.csv has no column {column}"
+assert not any(c.startswith("force_rock") for c in rows[0]), "rock hulls are not listed as walls"
+assert len(rows) == 31, len(rows)
+assert all(int(r["rocks"]) == summary["rocks"] for r in rows)
+assert float(rows[-1]["hoist_force_N"]) > 1e5, rows[-1]["hoist_force_N"]  # the ropes carry the dipper
+
+rock_frames = frames("rocks.pvd")
+assert len(rock_frames) == 4, len(rock_frames)  # t = 0, 0.1, 0.2, 0.3
+for d in rock_frames:
+    poly = read(d.get("file"))
+    cells = poly.GetNumberOfPolys()
+    assert cells >= 4 * summary["rocks"], cells
+    ids = poly.GetCellData().GetArray("rock")
+    for name in ("rock", "speed_m_per_s", "size_m"):
+        array = poly.GetCellData().GetArray(name)
+        assert array is not None and array.GetNumberOfTuples() == cells, name
+    assert {int(ids.GetValue(k)) for k in range(cells)} == set(range(summary["rocks"]))
+    sizes = {round(poly.GetCellData().GetArray("size_m").GetValue(k), 6) for k in range(cells)}
+    assert sizes <= {0.4, 0.6}, sizes  # each rock has its class's equivalent diameter
+
+wear_frames = frames("wear_dipper.pvd")
+assert len(wear_frames) == 4, len(wear_frames)
+poly = read(wear_frames[-1].get("file"))
+cells = poly.GetNumberOfPolys()
+for name in ("depth_mm", "wear_volume_m3", "mean_normal_force_N", "mean_tangential_force_N", "contact_steps", "impacts"):
+    array = poly.GetCellData().GetArray(name)
+    assert array is not None and array.GetNumberOfTuples() == cells, name
+assert poly.GetPointData().GetArray("depth_mm").GetNumberOfTuples() == poly.GetNumberOfPoints()
+touched = sum(1 for k in range(cells) if poly.GetCellData().GetArray("contact_steps").GetValue(k) > 0)
+assert touched > 0, "no contact on the dipper"
+for wall in ("wall_dipper.pvd", "wall_door.pvd"):
+    assert len(frames(wall)) == 4, wall
+assert not any(name.startswith("wall_rock") for name in os.listdir(folder)), "rock hulls are not written as walls"
+
+report = open(os.path.join(folder, "report.md")).read()
+for png in ("dig_force.png", "bucket.png"):
+    assert f"]({png})" in report and os.path.getsize(os.path.join(folder, png)) > 1000, png
+print(f"dipper run output with rocks and the shovel: {summary['rocks']} rocks in {len(rock_frames)} frames, "
+      f"{touched} dipper triangles touched, {len(rows)} probe rows: ok")
