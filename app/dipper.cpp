@@ -8,6 +8,7 @@
 //   dipper keys            (every scenario key as a Markdown table)
 #include "core/errors.h"
 #include "scenario/keys.h"
+#include "scenario/rigid_scene.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
 #include "scenario/sweep.h"
@@ -31,7 +32,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: dipper run FILE [--out DIR] [--threads N] [--stop-after SECONDS] [--quiet]\n"
-    "       dipper check FILE...\n"
+    "       dipper check FILE...   (scenario or sweep files)\n"
     "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
     "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
     "       dipper report DIR      (report.md with figures, also written after run and resume)\n"
@@ -97,6 +98,16 @@ void report(const RunResult& result, const std::string& dir)
     if (result.status == RunStatus::diverged)
         std::printf("the files written up to the failure are kept in %s; the last checkpoint (if any) can be resumed after "
                     "changing nothing, or the scenario rerun with a smaller time.step_s\n", dir.c_str());
+}
+
+/// True if the file is a sweep file (its top level has the key dipper_sweep).
+bool is_sweep_file(const std::string& path)
+{
+    std::ifstream in(path);
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("dipper_sweep:", 0) == 0) return true;
+    return false;
 }
 
 /// Writes DIR/report.md and its figures with report.py (Debian's python3 and matplotlib). A missing
@@ -188,14 +199,21 @@ int main(int argc, char** argv)
         if (command == "check") {
             if (o.positional.empty()) usage("check needs at least one scenario file");
             for (const std::string& file : o.positional) {
+                if (is_sweep_file(file)) {
+                    const Sweep sw = load_sweep(file);  // every variant is parsed and checked
+                    std::printf("%s: ok: sweep of %zu variants\n", file.c_str(), sw.variants().size());
+                    continue;
+                }
                 const Scenario s = load_scenario(file);
                 const auto world = build_world(s);  // mesh files are read and checked too
                 check_pairs(s);
+                // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
+                if (s.uses_coupling()) RigidScene scene(s, *world);
                 double fill = 0.0, pour = 0.0;
                 for (const auto& f : s.fills) fill += f.mass_kg;
                 for (const auto& p : s.pours) pour += p.mass_kg;
                 std::printf("%s: ok: '%s', %.6g s, %zu walls, %.6g kg filled, %.6g kg poured, %zu materials\n", file.c_str(),
-                            s.name.c_str(), s.duration_s, world->wall_count(), fill, pour, s.materials.size());
+                            s.name.c_str(), s.duration_s, s.planes.size() + s.meshes.size(), fill, pour, s.materials.size());
             }
             return 0;
         }

@@ -85,6 +85,87 @@ rigid::BodyId CoupledWorld::add_rock(const rigid::ConvexPolyhedron& shape, doubl
     return id;
 }
 
+void CoupledWorld::write_rocks(StateWriter& out) const
+{
+    out.tag("rocks");
+    out.value<std::uint64_t>(rocks_.size());
+    for (const RockRecord& r : rocks_) {
+        out.array(r.shape.vertices_m());
+        out.array(r.shape.triangles());
+        out.value(r.density_kg_per_m3);
+        out.value<std::int32_t>(r.rigid_material);
+        out.value(r.dem_material);
+    }
+}
+
+void CoupledWorld::read_rocks(StateReader& in)
+{
+    in.tag("rocks");
+    const auto n = in.value<std::uint64_t>();
+    if (n > in.left()) in.fail("more rocks than the file holds");
+    for (std::uint64_t k = 0; k < n; ++k) {
+        std::vector<Vec3> vertices;
+        std::vector<std::array<std::uint32_t, 3>> triangles;
+        in.array(vertices);
+        in.array(triangles);
+        const double density = in.value<double>();
+        const int rigid_material = in.value<std::int32_t>();
+        const auto dem_material = in.value<dem::MaterialIndex>();
+        for (const auto& t : triangles)
+            for (std::uint32_t v : t)
+                if (v >= vertices.size()) in.fail(concat("rock ", k, " has a triangle with vertex ", v, " of ", vertices.size()));
+        try {
+            const rigid::ConvexPolyhedron shape =
+                rigid::ConvexPolyhedron::from_mesh(meshes::TriangleMesh(std::move(vertices), std::move(triangles), "checkpoint rock"));
+            add_rock(shape, density, rigid_material, dem_material, {});
+        } catch (const InputError& e) {
+            in.fail(concat("rock ", k, ": ", e.what()));
+        }
+    }
+}
+
+void CoupledWorld::write_state(StateWriter& out) const
+{
+    out.tag("coupling");
+    out.value<std::uint64_t>(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        out.value(bodies_[k].applied_force_N);
+        out.value(bodies_[k].applied_torque_N_m);
+    }
+    out.array(before_);
+    out.array(after_);
+    out.array(spin_rad_);
+    out.array(force_sum_);
+    out.array(torque_sum_);
+    out.value<std::int32_t>(samples_);
+    out.value<std::uint8_t>(started_ ? 1 : 0);
+    out.value(rigid_seconds_);
+    out.value(surface_seconds_);
+}
+
+void CoupledWorld::read_state(StateReader& in)
+{
+    in.tag("coupling");
+    const auto n = in.value<std::uint64_t>();
+    if (n != bodies_.size()) in.fail(concat("the checkpoint couples ", n, " bodies, the world built from its scenario ", bodies_.size()));
+    for (CoupledBody& b : bodies_) {
+        b.applied_force_N = in.value<Vec3>();
+        b.applied_torque_N_m = in.value<Vec3>();
+    }
+    in.array(before_);
+    in.array(after_);
+    in.array(spin_rad_);
+    in.array(force_sum_);
+    in.array(torque_sum_);
+    for (std::size_t size : {before_.size(), after_.size(), spin_rad_.size(), force_sum_.size(), torque_sum_.size()})
+        if (size != bodies_.size()) in.fail("coupling arrays of another number of bodies");
+    samples_ = in.value<std::int32_t>();
+    started_ = in.value<std::uint8_t>() != 0;
+    rigid_seconds_ = in.value<double>();
+    surface_seconds_ = in.value<double>();
+    checked_bodies_ = 0;  // checked again before the next step
+}
+
 const CoupledBody& CoupledWorld::body(int index) const
 {
     if (index < 0 || static_cast<std::size_t>(index) >= bodies_.size())

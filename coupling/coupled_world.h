@@ -4,6 +4,7 @@
 // the body as a force and a torque about its centre of mass.
 #pragma once
 
+#include "core/state_io.h"
 #include "core/vec3.h"
 #include "dem/world.h"
 #include "meshes/triangle_mesh.h"
@@ -98,6 +99,16 @@ public:
     /// dem().phase_seconds()), summed since the start.
     double rigid_seconds() const { return rigid_seconds_; }
     double surface_seconds() const { return surface_seconds_; }
+
+    // ---- checkpoints (with RigidWorld and dem::World's own write_state and read_state)
+    /// The rocks made with add_rock: shape, density and materials, in order.
+    void write_rocks(StateWriter& out) const;
+    /// Makes the rocks of write_rocks again, in a world built like the one written (before the worlds'
+    /// own read_state, which then sets their poses and velocities).
+    void read_rocks(StateReader& in);
+    /// What passes between the worlds: surface poses over the step, the sub-steps' reaction sums.
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
 
     // ---- whole-system balances (tests, probes)
     Vec3 linear_momentum_kg_m_per_s() const;   ///< spheres and dynamic rocks

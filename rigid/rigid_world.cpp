@@ -331,6 +331,98 @@ void RigidWorld::step()
 
 double RigidWorld::time_s() const { return impl_->time_s; }
 
+namespace {
+
+void write_transform(StateWriter& out, const btTransform& t)
+{
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) out.value<double>(t.getBasis()[i][j]);
+    out.value(from_bt(t.getOrigin()));
+}
+
+btTransform read_transform(StateReader& in)
+{
+    btMatrix3x3 basis;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) basis[i][j] = in.value<double>();
+    return btTransform(basis, to_bt(in.value<Vec3>()));
+}
+
+std::vector<Vec3> as_vec3s(const std::vector<btVector3>& v)
+{
+    std::vector<Vec3> out;
+    for (const btVector3& x : v) out.push_back(from_bt(x));
+    return out;
+}
+
+}  // namespace
+
+void RigidWorld::write_state(StateWriter& out) const
+{
+    const Impl& w = *impl_;
+    out.tag("rigid world");
+    out.value<std::uint64_t>(w.bodies.size());
+    out.value(w.time_s);
+    out.value(w.step_count);
+    out.value(w.settings.step_s);
+    for (const auto& b : w.bodies) {
+        out.text(b->name);
+        if (b->body) {
+            write_transform(out, b->body->getWorldTransform());
+            out.value(from_bt(b->body->getLinearVelocity()));
+            out.value(from_bt(b->body->getAngularVelocity()));
+        } else {
+            write_transform(out, b->previous_pose);
+        }
+    }
+    out.array(w.contact_force);
+    out.array(as_vec3s(w.velocity_before));
+    out.array(as_vec3s(w.spin_before));
+    out.value<std::uint8_t>(w.shovel ? 1 : 0);
+    if (w.shovel) write_shovel_state(*w.shovel, out);
+}
+
+void RigidWorld::read_state(StateReader& in)
+{
+    Impl& w = *impl_;
+    in.tag("rigid world");
+    const auto n = in.value<std::uint64_t>();
+    if (n != w.bodies.size())
+        in.fail(concat("the checkpoint has ", n, " rigid bodies, the world built from its scenario ", w.bodies.size()));
+    w.time_s = in.value<double>();
+    w.step_count = in.value<std::uint64_t>();
+    w.settings.step_s = in.value<double>();
+    for (auto& b : w.bodies) {
+        const std::string name = in.text();
+        if (name != b->name) in.fail(concat("rigid body '", name, "' where the world has '", b->name, "'"));
+        if (b->body) {
+            const btTransform t = read_transform(in);
+            const btVector3 v = to_bt(in.value<Vec3>()), omega = to_bt(in.value<Vec3>());
+            b->body->setWorldTransform(t);
+            b->body->setInterpolationWorldTransform(t);
+            b->motion->setWorldTransform(t);
+            b->body->setLinearVelocity(v);
+            b->body->setAngularVelocity(omega);
+            b->body->setInterpolationLinearVelocity(v);
+            b->body->setInterpolationAngularVelocity(omega);
+        } else {
+            b->previous_pose = read_transform(in);
+        }
+    }
+    in.array(w.contact_force);
+    std::vector<Vec3> before, spin;
+    in.array(before);
+    in.array(spin);
+    w.velocity_before.clear();
+    w.spin_before.clear();
+    for (const Vec3& x : before) w.velocity_before.push_back(to_bt(x));
+    for (const Vec3& x : spin) w.spin_before.push_back(to_bt(x));
+    const bool shovel = in.value<std::uint8_t>() != 0;
+    if (shovel != (w.shovel != nullptr)) in.fail("the checkpoint and the world differ in having a rope shovel");
+    if (shovel) read_shovel_state(*w.shovel, in);
+    if (w.contact_force.size() != w.bodies.size()) in.fail("rigid contact forces of another number of bodies");
+}
+
 void RigidWorld::set_step_s(double step_s)
 {
     require_positive(step_s, "step_s", "rigid world");

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/contact_record.h"
+#include "core/state_io.h"
 #include "core/vec3.h"
 #include "meshes/machine_geometry.h"
 #include "meshes/triangle_mesh.h"
@@ -122,6 +123,15 @@ public:
     const RigidSettings& settings() const;
     /// Changes the step for the steps that follow (for example: settle a pile at a coarse step).
     void set_step_s(double step_s);
+
+    // ---- checkpoints
+    /// Writes the moving state: time, every rock's and kinematic part's pose and velocities, the shovel's
+    /// joints, ropes and force filter. Bullet's contact caches (warm starting) are not part of it, so a
+    /// run continued from it follows the uninterrupted run closely but not bit for bit.
+    void write_state(StateWriter& out) const;
+    /// Reads what write_state wrote into a world built the same way (same bodies in the same order);
+    /// anything else is an InputError naming what differs.
+    void read_state(StateReader& in);
 
     // ---- contacts of the last step
     /// Sum of contact forces (impulses / step) on a body during the last step, N.

@@ -423,6 +423,47 @@ void shovel_after_step(RigidWorld::Impl& w)
     read_pose(s);
 }
 
+void write_shovel_state(const ShovelState& s, StateWriter& out)
+{
+    out.tag("rope shovel");
+    for (int j = 0; j < 4; ++j) {
+        out.value<double>(s.body->getJointPos(j));
+        out.value<double>(s.body->getJointVel(j));
+    }
+    for (int r = 0; r < 2; ++r) {
+        out.value(s.previous_length[r]);
+        out.value(s.tension[r]);
+    }
+    out.value<std::uint8_t>(s.started ? 1 : 0);
+    out.value<std::uint64_t>(s.window.size());
+    for (const auto& x : s.window) out.value(x);
+    out.value(s.reading);
+}
+
+void read_shovel_state(ShovelState& s, StateReader& in)
+{
+    in.tag("rope shovel");
+    btMultiBody& mb = *s.body;
+    for (int j = 0; j < 4; ++j) {
+        mb.setJointPos(j, in.value<double>());
+        mb.setJointVel(j, in.value<double>());
+    }
+    btAlignedObjectArray<btQuaternion> scratch_q;
+    btAlignedObjectArray<btVector3> scratch_m;
+    mb.forwardKinematics(scratch_q, scratch_m);
+    mb.updateCollisionObjectWorldTransforms(scratch_q, scratch_m);
+    for (int r = 0; r < 2; ++r) {
+        s.previous_length[r] = in.value<double>();
+        s.tension[r] = in.value<double>();
+    }
+    s.started = in.value<std::uint8_t>() != 0;
+    const auto n = in.value<std::uint64_t>();
+    if (n > in.left() / sizeof(ShovelState::Sample)) in.fail("a force window longer than the file");
+    s.window.clear();
+    for (std::uint64_t k = 0; k < n; ++k) s.window.push_back(in.value<ShovelState::Sample>());
+    s.reading = in.value<ShovelReading>();
+}
+
 const ShovelReading& RigidWorld::shovel_reading() const
 {
     if (!impl_->shovel) throw InputError("shovel_reading: the world has no rope shovel");

@@ -97,6 +97,7 @@ const std::vector<KeySpec>& scenario_keys()
          "default_cycle (three passes of 46 s: dig 15 s, swing, dump, return) or a CSV file of time_s, hoist_length_m, "
          "crowd_extension_m, swing_deg, door_deg"},
         {"shovel.start_s", "number", "0", "the motion starts at this time; before it the shovel holds its first pose (a pile settles)"},
+        {"shovel.passes", "integer", "0", "the run ends 1 s after the door of this pass opened; 0: it runs for time.duration_s"},
         {"shovel.dig_speed_factor", "number", "1", "the default cycle's dig done this many times faster (0.5 to 2)"},
         {"shovel.bulk_density_kg_per_m3", "number", "1903", "bulk density for the fill factor: mass in the dipper / (bulk density x struck volume)"},
 

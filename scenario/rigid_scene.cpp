@@ -189,6 +189,40 @@ void RigidScene::step()
     track_passes();
 }
 
+void RigidScene::write_state(StateWriter& out) const
+{
+    rigid_->write_state(out);
+    coupled_->write_state(out);
+    out.tag("scene");
+    out.value<std::uint64_t>(wear_.size());
+    for (const SceneWear& w : wear_) w.surface->write_state(out);
+    out.array(passes_);
+    out.value<std::uint8_t>(door_open_ ? 1 : 0);
+    out.value(pass_start_s_);
+    out.value(dig_start_s_);
+    out.value(dig_end_s_);
+    out.value(dig_force_sum_);
+    out.value(dig_force_peak_);
+    out.value(dig_samples_);
+}
+
+void RigidScene::read_state(StateReader& in)
+{
+    rigid_->read_state(in);
+    coupled_->read_state(in);
+    in.tag("scene");
+    if (in.value<std::uint64_t>() != wear_.size()) in.fail("another number of wear surfaces than the scenario has");
+    for (SceneWear& w : wear_) w.surface->read_state(in);
+    in.array(passes_);
+    door_open_ = in.value<std::uint8_t>() != 0;
+    pass_start_s_ = in.value<double>();
+    dig_start_s_ = in.value<double>();
+    dig_end_s_ = in.value<double>();
+    dig_force_sum_ = in.value<double>();
+    dig_force_peak_ = in.value<double>();
+    dig_samples_ = in.value<std::uint64_t>();
+}
+
 const rigid::ShovelReading& RigidScene::reading() const
 {
     return rigid_->shovel_reading();

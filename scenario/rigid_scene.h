@@ -59,6 +59,11 @@ public:
     /// One coupling step (substeps DEM steps), wear and passes included.
     void step();
 
+    /// Checkpoints, after the DEM world's state: Bullet's bodies and shovel, the coupling, the wear sums
+    /// and the passes. The rocks themselves go first, with coupled().write_rocks.
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
+
     coupling::CoupledWorld& coupled() { return *coupled_; }
     const coupling::CoupledWorld& coupled() const { return *coupled_; }
     rigid::RigidWorld& rigid() { return *rigid_; }
@@ -99,7 +104,7 @@ private:
     std::vector<SceneWear> wear_;
     std::vector<PassRecord> passes_;
     // pass tracking
-    bool digging_ = true, door_open_ = false;
+    bool door_open_ = false;
     double pass_start_s_ = 0.0, dig_start_s_ = -1.0, dig_end_s_ = -1.0, dig_force_sum_ = 0.0, dig_force_peak_ = 0.0;
     std::uint64_t dig_samples_ = 0;
 };

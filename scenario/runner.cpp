@@ -134,9 +134,15 @@ public:
     void start_from(StateReader& in)
     {
         world_ = build_world(scenario_);
+        if (scenario_.uses_coupling()) {
+            // the bodies in the order of the run: walls and shovel, the rocks, then the wear surfaces
+            rigid_ = std::make_unique<RigidScene>(scenario_, *world_);
+            rigid_->coupled().read_rocks(in);
+            rigid_->add_wear(scenario_);
+        }
         pourers_ = make_pourers(scenario_, *world_);
-        DIPPER_ASSERT(!scenario_.uses_coupling(), "coupled runs write no checkpoints");
         world_->read_state(in);
+        if (rigid_) rigid_->read_state(in);
         in.tag("pours");
         for (dem::Pourer& p : pourers_) p.read_state(in);
         in.tag("outputs");
@@ -148,7 +154,8 @@ public:
         steps_before_ = in.value<std::uint64_t>();
         const auto csv_bytes = in.value<std::uint64_t>();
         walls_ = all_walls();
-        std::vector<std::vector<std::pair<double, std::string>>> entries(1 + world_->wall_count());
+        const std::size_t series = 1 + walls_.size() + (rigid_ ? 1 + rigid_->wear().size() : 0);
+        std::vector<std::vector<std::pair<double, std::string>>> entries(series);
         for (auto& e : entries) {
             const auto n = in.value<std::uint64_t>();
             if (n > in.left()) in.fail("too many snapshot entries");
@@ -159,9 +166,17 @@ public:
         }
         in.finish();
         open_outputs(true, csv_bytes);
-        particles_pvd_->restore(entries[0]);
-        for (std::size_t w = 0; w < wall_pvd_.size(); ++w)
-            if (wall_pvd_[w]) wall_pvd_[w]->restore(entries[1 + w]);
+        std::size_t k = 0;
+        particles_pvd_->restore(entries[k++]);
+        for (const auto& w : wall_pvd_) {
+            if (w) w->restore(entries[k]);
+            ++k;
+        }
+        if (rigid_) {
+            if (rocks_pvd_) rocks_pvd_->restore(entries[k]);
+            ++k;
+            for (const auto& w : wear_pvd_) w->restore(entries[k++]);
+        }
     }
 
     RunResult loop()
@@ -171,16 +186,23 @@ public:
         last_progress_ = start;
         const std::uint64_t first_step = world_->step_count();
         const bool terminal = isatty(fileno(stderr)) != 0;
-        const double end_s = scenario_.duration_s;
+        double end_s = scenario_.duration_s;
         const double dt = world_->step_s();
         RunResult result;
         // the run ends at the first step that reaches duration_s (within a millionth of a step)
         const auto reached = [&](double t) { return world_->time_s() >= t - 1e-6 * dt; };
+        // a shovel run may end after a number of passes: 1 s after the last one's door opened
+        const std::size_t passes = scenario_.shovel ? static_cast<std::size_t>(scenario_.shovel->passes) : 0;
         try {
             while (!reached(end_s)) {
                 const std::uint64_t before = world_->step_count();
-                if (rigid_) rigid_->step();
-                else world_->step();
+                if (rigid_) {
+                    rigid_->step();
+                    if (passes > 0 && rigid_->passes().size() >= passes)
+                        end_s = std::min(end_s, rigid_->passes()[passes - 1].dump_s + 1.0);
+                } else {
+                    world_->step();
+                }
                 if (world_->step_count() / kPourEvery != before / kPourEvery)
                     for (dem::Pourer& p : pourers_) p.update(*world_);
                 if (reached(next_csv_s_)) {
@@ -202,7 +224,6 @@ public:
                     result.status = RunStatus::interrupted;
                     result.message = g_signal != 0 ? concat("stopped by signal ", static_cast<int>(g_signal))
                                                    : concat("stopped at t = ", world_->time_s(), " s as asked");
-                    if (rigid_) result.message += "; runs with rocks, a shovel or wear write no checkpoint yet, so this one cannot be resumed";
                     break;
                 }
             }
@@ -377,14 +398,15 @@ private:
 
     void checkpoint()
     {
-        if (rigid_) return;  // Bullet's state is not saved yet (docs/limits.md)
         StateWriter out;
         out.tag("run");
         out.text(scenario_.text);
         out.text(scenario_.source);
         out.text(scenario_.base_dir);
         out.value<std::int32_t>(world_->threads());
+        if (rigid_) rigid_->coupled().write_rocks(out);
         world_->write_state(out);
+        if (rigid_) rigid_->write_state(out);
         out.tag("pours");
         for (const dem::Pourer& p : pourers_) p.write_state(out);
         out.tag("outputs");
@@ -405,7 +427,11 @@ private:
             }
         };
         write_entries(particles_pvd_.get());
-        for (std::size_t w = 0; w < world_->wall_count(); ++w) write_entries(wall_pvd_[w].get());
+        for (const auto& w : wall_pvd_) write_entries(w.get());
+        if (rigid_) {
+            write_entries(rocks_pvd_.get());
+            for (const auto& w : wear_pvd_) write_entries(w.get());
+        }
         // the new file first, then the old one becomes the previous: a good checkpoint always exists
         const fs::path dir(dir_);
         out.save((dir / "checkpoint.next.bin").string(), kCheckpointMagic);
@@ -556,14 +582,6 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
         if (fs::exists(dir / "checkpoint.next.bin") || fs::exists(dir / "checkpoint.prev.bin"))
             hint = concat("; try --from ", fs::exists(dir / "checkpoint.next.bin") ? (dir / "checkpoint.next.bin").string()
                                                                                    : (dir / "checkpoint.prev.bin").string());
-        if (hint.empty() && fs::exists(dir / "scenario.yaml")) {
-            bool coupled = false;
-            try {
-                coupled = load_scenario((dir / "scenario.yaml").string()).uses_coupling();
-            } catch (const InputError&) {
-            }
-            if (coupled) hint = "; runs with rocks, a shovel or wear write no checkpoints yet, so this run cannot be resumed";
-        }
         throw InputError(concat("no checkpoint '", path, "' to resume from", hint));
     }
     std::unique_ptr<StateReader> in;
@@ -579,7 +597,6 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
     const std::string text = in->text(), source = in->text(), base_dir = in->text();
     const int threads = in->value<std::int32_t>();
     Scenario scenario = parse_scenario(text, source, base_dir);
-    DIPPER_ASSERT(!scenario.uses_coupling(), "a checkpoint of a coupled run");
     RunOptions o = options;
     if (o.threads <= 0) o.threads = threads;  // same thread count, same bits
     Run run(std::move(scenario), out_dir, o);

@@ -370,6 +370,9 @@ ShovelSpec read_shovel(const Scenario& s, const MapReader& m)
                                                : std::filesystem::path(s.base_dir) / sh.motion;
         sh.motion = file.string();
     }
+    const std::int64_t passes = m.integer("passes");
+    if (passes < 0 || passes > 1000) m.fail("passes", concat(passes), "0 (run for time.duration_s) or a number of passes");
+    sh.passes = static_cast<int>(passes);
     sh.start_s = m.number("start_s");
     require_non_negative(sh.start_s, "start_s", m.where("start_s"));
     sh.dig_speed_factor = m.number("dig_speed_factor");

@@ -69,6 +69,7 @@ struct ShovelSpec {
     std::string material = "bucket";
     std::string motion = "default_cycle";  ///< or a CSV file, absolute or relative to base_dir
     double start_s = 0.0;
+    int passes = 0;  ///< > 0: the run ends 1 s after this pass's dump
     double dig_speed_factor = 1.0;
     double bulk_density_kg_per_m3 = 1903.0;
     std::string where;

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -232,32 +233,71 @@ int run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const Run
     return failed;
 }
 
+namespace {
+
+/// The passes of a summary.json, each as the text of its {...} object.
+std::vector<std::string> pass_objects(const std::string& summary)
+{
+    std::vector<std::string> passes;
+    const std::size_t start = summary.find("\"passes\": [");
+    if (start == std::string::npos) return passes;
+    const std::size_t end = summary.find(']', start);
+    std::size_t at = summary.find("{\"pass\":", start);
+    while (at != std::string::npos && at < end) {
+        const std::size_t close = summary.find('}', at);
+        passes.push_back(summary.substr(at, close - at + 1));
+        at = summary.find("{\"pass\":", close);
+    }
+    return passes;
+}
+
+}  // namespace
+
 void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
 {
     const auto all = sweep.variants();
-    const std::string path = (fs::path(out_dir) / "sweep.csv").string();
-    std::ofstream out = open_for_writing(path);
-    out << "variant";
-    for (const auto& p : sweep.parameters) out << ',' << p.key;
-    out << ",status,time_s,steps,particles,mass_kg,kinetic_energy_J,state_hash";
-    // region masses and wall forces as in the first variant's summary
-    const Scenario first = sweep.variant_scenario(0);
-    for (const RegionProbe& r : first.regions) out << ',' << r.name << "_mass_kg";
-    out << '\n';
+    std::vector<std::string> summaries;
+    std::size_t passes = 0;
     for (std::size_t v = 0; v < all.size(); ++v) {
         const std::string summary_path = variant_dir(out_dir, v) + "/summary.json";
         std::ifstream in(summary_path);
         if (!in) throw InputError(concat("sweep variant ", v, " has no summary ('", summary_path, "'); did it run?"));
         std::stringstream text;
         text << in.rdbuf();
-        const std::string s = text.str();
+        summaries.push_back(text.str());
+        passes = std::max(passes, pass_objects(summaries.back()).size());
+    }
+    const std::string path = (fs::path(out_dir) / "sweep.csv").string();
+    std::ofstream out = open_for_writing(path);
+    out << "variant";
+    for (const auto& p : sweep.parameters) out << ',' << p.key;
+    out << ",status,time_s,steps,particles,mass_kg,kinetic_energy_J,state_hash";
+    // region masses, passes and wear as in the first variant's scenario
+    const Scenario first = sweep.variant_scenario(0);
+    for (const RegionProbe& r : first.regions) out << ',' << r.name << "_mass_kg";
+    for (std::size_t k = 1; k <= passes; ++k)
+        out << ",pass" << k << "_mass_kg,pass" << k << "_fill_factor,pass" << k << "_mean_dig_force_N";
+    if (first.shovel) out << ",tonnage_t";
+    for (const WearSpec& w : first.wear) out << ",wear_" << w.part << "_m3";
+    out << '\n';
+    for (std::size_t v = 0; v < all.size(); ++v) {
+        const std::string& s = summaries[v];
         out << v;
         for (const std::string& value : all[v]) out << ",\"" << value << '"';
         for (const char* key : {"status", "time_s", "steps", "particles", "mass_kg", "kinetic_energy_J", "state_hash"})
             out << ',' << json_field(s, key);
-        // region names are looked up inside region_mass_kg only (a wall may carry the same name)
+        // names are looked up inside their own objects (a wall may carry a region's name)
         const std::string regions = s.substr(std::min(s.size(), s.find("\"region_mass_kg\"")));
         for (const RegionProbe& r : first.regions) out << ',' << json_field(regions, r.name);
+        const std::vector<std::string> p = pass_objects(s);
+        for (std::size_t k = 0; k < passes; ++k)
+            for (const char* key : {"mass_kg", "fill_factor", "mean_dig_force_N"}) out << ',' << (k < p.size() ? json_field(p[k], key) : "");
+        if (first.shovel) out << ',' << json_field(s, "tonnage_t");
+        const std::string wear = s.substr(std::min(s.size(), s.find("\"wear\": {")));
+        for (const WearSpec& w : first.wear) {
+            const std::string part = wear.substr(std::min(wear.size(), wear.find("\"" + w.part + "\": {")));
+            out << ',' << json_field(part, "volume_m3");
+        }
         out << '\n';
     }
     finish_writing(out, path);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/contact_record.h"
+#include "core/state_io.h"
 #include "meshes/triangle_mesh.h"
 #include "wear/laws.h"
 
@@ -78,6 +79,11 @@ public:
     /// Depth at a point on the surface (body frame), interpolated from the nodal depths of the closest
     /// triangle. Throws InputError if the point is farther than `tolerance_m` from the surface.
     double depth_at_m(const Vec3& point_m, int smoothing_iterations, double tolerance_m, const std::string& what) const;
+
+    /// Checkpoints: the accumulated time and the per-triangle sums. read_state refuses a state of a
+    /// mesh with another number of triangles.
+    void write_state(StateWriter& out) const;
+    void read_state(StateReader& in);
 
     /// The same surface with every wear volume and the law's constant multiplied by `factor`: what a
     /// re-run with the scaled constant gives, for laws linear in their constant.

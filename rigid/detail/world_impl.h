@@ -197,6 +197,10 @@ void add_plate_hulls(btCompoundShape& compound, std::vector<std::unique_ptr<btCo
                      const std::vector<meshes::Plate>& plates, const btTransform& transform, double max_margin_m,
                      const std::string& name);
 
+/// The shovel's part of a checkpoint (rope_shovel.cpp).
+void write_shovel_state(const ShovelState& s, StateWriter& out);
+void read_shovel_state(ShovelState& s, StateReader& in);
+
 // The rope shovel's share of a step (rope_shovel.cpp): motor targets and rope forces before Bullet steps,
 // drive forces read after.
 void shovel_before_step(RigidWorld::Impl& world, double time_after_step_s);
