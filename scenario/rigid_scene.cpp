@@ -179,9 +179,57 @@ void RigidScene::add_wear(const Scenario& s)
         });
 }
 
+namespace {
+
+/// True if x lies inside the plate's steel: behind its face by at most its thickness, and inside the
+/// face's convex quadrilateral.
+bool inside_plate(const meshes::Plate& p, const Vec3& x)
+{
+    const Vec3 n = p.normal();
+    const double depth = dot(x - p.corners_m[0], n);
+    if (depth > 0.0 || depth < -p.thickness_m) return false;
+    for (std::size_t k = 0; k < 4; ++k) {
+        const Vec3& a = p.corners_m[k];
+        const Vec3& b = p.corners_m[(k + 1) % 4];
+        if (dot(cross(b - a, x - a), n) < 0.0) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+void RigidScene::check_tunnelling() const
+{
+    if (!has_shovel() || coupled_->rocks().empty()) return;
+    for (int part = 0; part < 2; ++part) {
+        Mat3 r;
+        Vec3 o;
+        if (part == 0) rigid_->dipper_pose(r, o);
+        else rigid_->door_pose(r, o);
+        const Mat3 back = r.transposed();
+        const std::vector<meshes::Plate>& plates = part == 0 ? dipper_.body.plates : dipper_.door.plates;
+        for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
+            const rigid::BodyId id = coupled_->rocks()[k].body;
+            const Vec3 c = rigid_->state(id).position_m;
+            const Vec3 q = back * (c - o);
+            for (std::size_t p = 0; p < plates.size(); ++p)
+                if (inside_plate(plates[p], q)) {
+                    const double dt = coupled_->dem_step_s();
+                    throw SimulationError(concat(
+                        "t = ", coupled_->time_s(), " s: rock ", k, " (", coupled_->rocks()[k].shape.equivalent_diameter_m(),
+                        " m, speed ", norm(rigid_->state(id).velocity_m_per_s), " m/s) has its centre at (", c.x, ", ", c.y,
+                        ", ", c.z, ") m inside plate ", p, " of the ", part == 0 ? "dipper" : "door",
+                        ": it went through the steel. Reduce time.step_s (now ", dt, " s; try ", dt / 2.0,
+                        " s) or coupling.substeps (now ", coupled_->settings().substeps, ")"));
+                }
+        }
+    }
+}
+
 void RigidScene::step()
 {
     coupled_->step();
+    check_tunnelling();
     const double dt = coupled_->coupling_step_s();
     for (SceneWear& w : wear_)
         if (w.body >= 0)

@@ -88,6 +88,10 @@ public:
     void write_rocks_vtp(const std::string& path) const;
     double rock_kinetic_energy_J() const { return rigid_->kinetic_energy_J(); }
 
+    /// Throws SimulationError naming the rock, where and when, if a rock's centre lies inside the steel
+    /// of the dipper or door (it went through a plate). Called after every step.
+    void check_tunnelling() const;
+
 private:
     void track_passes();
 

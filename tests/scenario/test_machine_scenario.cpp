@@ -3,6 +3,7 @@
 // dipper and the fill factor count exactly that material; a pass is recorded when the door opens).
 #include "core/errors.h"
 #include "meshes/machine_geometry.h"
+#include "rigid/convex_polyhedron.h"
 #include "rigid/motion_curves.h"
 #include "rigid/rope_shovel.h"
 #include "scenario/rigid_scene.h"
@@ -181,4 +182,28 @@ shovel: {motion: held.csv, element_size_m: 0.3}
     CHECK(p.mean_dig_force_N == 0.0);                // the hoist never hauled in: no dig phase
     CHECK(scene.tonnage_t() == Approx(p.mass_kg / 1000.0));
     fs::remove_all(dir);
+}
+
+TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a diagnosis", "[scenario][shovel]")
+{
+    const Scenario s = parse_scenario(base("shovel: {element_size_m: 0.3}\n"), "case.yaml", ".");
+    auto dem = build_world(s);
+    RigidScene scene(s, *dem);
+    build_particles(s, *dem);
+    scene.step();
+    CHECK_NOTHROW(scene.check_tunnelling());  // no rocks: nothing to check
+
+    // a 0.3 m cube with its centre 5 cm deep in the bottom plate (0.1 m thick, below the dipper's z = 0)
+    std::vector<Vec3> corners;
+    for (double x : {-0.15, 0.15})
+        for (double y : {-0.15, 0.15})
+            for (double z : {-0.15, 0.15}) corners.push_back({x, y, z});
+    const rigid::ConvexPolyhedron cube = rigid::ConvexPolyhedron::hull_of(corners, "cube").in_principal_frame();
+    Mat3 r;
+    Vec3 o;
+    scene.rigid().dipper_pose(r, o);
+    const Vec3 centre = o + r * Vec3{2.0, 0.0, -0.05};
+    scene.coupled().add_rock(cube, 3000.0, scene.rigid().material_index("rock"), dem->materials().index_of("rock"), centre);
+    CHECK_THROWS_WITH(scene.check_tunnelling(), Catch::Contains("rock 0 (") && Catch::Contains("inside plate 0 of the dipper") &&
+                                                    Catch::Contains("went through the steel") && Catch::Contains("Reduce time.step_s"));
 }
