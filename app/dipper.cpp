@@ -7,6 +7,7 @@
 //   dipper report DIR      (report.md and PNG figures from summary.json and probes.csv)
 //   dipper keys            (every scenario key as a Markdown table)
 #include "core/errors.h"
+#include "scenario/calibrate.h"
 #include "scenario/keys.h"
 #include "scenario/rigid_scene.h"
 #include "scenario/runner.h"
@@ -17,6 +18,7 @@
 #include <mpi.h>
 #endif
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -35,6 +37,8 @@ constexpr const char* kUsage =
     "       dipper check FILE...   (scenario or sweep files)\n"
     "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
     "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
+    "       dipper calibrate repose FILE [--target DEG] [--tolerance DEG] [--pair A,B] [--rolling R1,R2,...]\n"
+    "                              [--out DIR] [--threads N] [--quiet]\n"
     "       dipper report DIR      (report.md with figures, also written after run and resume)\n"
     "       dipper keys\n";
 
@@ -48,7 +52,17 @@ struct Options {
     std::vector<std::string> positional;
     std::string out, from;
     RunOptions run;
+    ReposeSearch repose;
+    std::string pair_a = "ore", pair_b = "ore";
 };
+
+double number_option(const std::string& option, const std::string& v)
+{
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(x)) usage(option + " needs a number; got '" + v + "'");
+    return x;
+}
 
 Options parse_options(int argc, char** argv, int first)
 {
@@ -72,6 +86,21 @@ Options parse_options(int argc, char** argv, int first)
             char* end = nullptr;
             o.run.stop_after_s = std::strtod(v.c_str(), &end);
             if (v.empty() || *end != '\0' || !(o.run.stop_after_s > 0.0)) usage("--stop-after needs seconds > 0; got '" + v + "'");
+        } else if (arg == "--target") {
+            o.repose.target_deg = number_option(arg, value());
+        } else if (arg == "--tolerance") {
+            o.repose.tolerance_deg = number_option(arg, value());
+        } else if (arg == "--pair") {
+            const std::string v = value();
+            const auto comma = v.find(',');
+            if (comma == std::string::npos || comma == 0 || comma + 1 == v.size()) usage("--pair needs two materials A,B; got '" + v + "'");
+            o.pair_a = v.substr(0, comma);
+            o.pair_b = v.substr(comma + 1);
+        } else if (arg == "--rolling") {
+            std::string v = value() + ",";
+            o.repose.rolling_frictions.clear();
+            for (std::size_t at = 0, comma; (comma = v.find(',', at)) != std::string::npos; at = comma + 1)
+                o.repose.rolling_frictions.push_back(number_option(arg, v.substr(at, comma - at)));
         } else if (arg == "--quiet") o.run.progress = false;
         else if (!arg.empty() && arg[0] == '-') usage("unknown option " + arg);
         else o.positional.push_back(arg);
@@ -240,6 +269,21 @@ int main(int argc, char** argv)
         if (command == "sweep") {
             if (o.positional.size() != 1) usage("sweep needs exactly one sweep file");
             return sweep(o);
+        }
+        if (command == "calibrate") {
+            if (o.positional.size() != 2 || o.positional[0] != "repose") usage("calibrate needs 'repose' and one scenario file");
+            const std::string dir = o.out.empty() ? "out/calibrate_repose" : o.out;
+            RunOptions quiet_runs = o.run;
+            const ReposeCalibration c = calibrate_repose(o.positional[1], o.pair_a, o.pair_b, o.repose, dir, quiet_runs);
+            std::printf("dipper calibrate repose: %zu runs, target %.4g +- %.4g deg\n", c.runs.size(), o.repose.target_deg,
+                        o.repose.tolerance_deg);
+            for (const ReposeRun& r : c.matches)
+                std::printf("  hit: friction %.4g, rolling friction %.4g -> %.2f deg\n", r.friction, r.rolling_friction, r.angle_deg);
+            for (const std::string& n : c.notes) std::printf("  %s\n", n.c_str());
+            if (c.matches.size() > 1)
+                std::printf("  %zu pairs hit the target: the repose angle alone does not fix sliding and rolling friction\n", c.matches.size());
+            std::printf("table: %s/calibration.csv, %s/calibration.md\n", dir.c_str(), dir.c_str());
+            return c.matches.empty() ? 3 : 0;
         }
         usage("unknown command '" + command + "'");
     } catch (const InputError& e) {

@@ -288,6 +288,7 @@ private:
         for (int w : walls_)
             for (const char* axis : {"x", "y", "z"}) csv_ << ",force_" << world_->wall_name(w) << "_" << axis << "_N";
         for (const RegionProbe& r : scenario_.regions) csv_ << "," << r.name << "_mass_kg";
+        if (scenario_.repose) csv_ << ",repose_angle_deg";
         if (rigid_) {
             csv_ << ",rocks,rock_kinetic_energy_J,rock_contacts";
             if (rigid_->has_shovel())
@@ -311,6 +312,16 @@ private:
         return mass;
     }
 
+    /// The repose probe's angle now; NaN while the window holds no slope to fit.
+    double repose_angle_deg() const
+    {
+        try {
+            return dem::fit_repose_angle(world_->particles(), scenario_.repose->window, scenario_.repose->where).angle_deg;
+        } catch (const InputError&) {
+            return std::numeric_limits<double>::quiet_NaN();
+        }
+    }
+
     void write_row()
     {
         const dem::World& w = *world_;
@@ -322,6 +333,7 @@ private:
             csv_ << ',' << f.x << ',' << f.y << ',' << f.z;
         }
         for (const RegionProbe& r : scenario_.regions) csv_ << ',' << region_mass_kg(r);
+        if (scenario_.repose) csv_ << ',' << repose_angle_deg();
         if (rigid_) {
             const rigid::RigidWorld& rw = rigid_->rigid();
             csv_ << ',' << rigid_->coupled().rocks().size() << ',' << rw.kinetic_energy_J() << ',' << rw.contact_point_count();
@@ -489,7 +501,9 @@ private:
         out << "},\n  \"region_mass_kg\": {";
         for (std::size_t k = 0; k < scenario_.regions.size(); ++k)
             out << (k ? ", " : "") << "\"" << json_escape(scenario_.regions[k].name) << "\": " << json_number(region_mass_kg(scenario_.regions[k]));
-        out << "},\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
+        out << "}";
+        if (scenario_.repose) out << ",\n  \"repose_angle_deg\": " << json_number(repose_angle_deg());
+        out << ",\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
             << "  \"state_hash\": \"" << hash << "\"";

@@ -515,6 +515,20 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         s.regions.push_back(region);
     }
 
+    if (probes.has("repose")) {
+        const MapReader r = probes.map("repose");
+        ReposeProbe p;
+        p.where = r.where("min_m");
+        read_box(r, p.window.min_m, p.window.max_m, "min_m", "max_m");
+        const std::string along = r.text("along");
+        if (along != "x" && along != "y") r.fail("along", concat("\"", along, "\""), "x or y");
+        p.window.along = along[0];
+        p.window.bin_m = r.number("bin_m");
+        require_positive(p.window.bin_m, "bin_m", r.where("bin_m"));
+        p.window.validate(r.where("bin_m"));
+        s.repose = p;
+    }
+
     const MapReader out = top.map("output");
     s.output.vtk_interval_s = out.number("vtk_interval_s");
     require_non_negative(s.output.vtk_interval_s, "vtk_interval_s", out.where("vtk_interval_s"));

@@ -5,6 +5,7 @@
 #include "core/vec3.h"
 #include "dem/insertion.h"
 #include "dem/material.h"
+#include "dem/pile.h"
 #include "dem/walls.h"
 #include "dem/world.h"
 
@@ -83,6 +84,11 @@ struct WearSpec {
     std::string where;
 };
 
+struct ReposeProbe {
+    dem::ReposeWindow window;
+    std::string where;
+};
+
 struct OutputSpec {
     double vtk_interval_s = 0.1, csv_interval_s = 0.01, checkpoint_interval_s = 0.0, progress_interval_s = 10.0;
 };
@@ -103,6 +109,7 @@ struct Scenario {
     std::vector<FillSpec> fills;
     std::vector<PourSpec> pours;
     std::vector<RegionProbe> regions;
+    std::optional<ReposeProbe> repose;
     OutputSpec output;
     int coupling_substeps = 5;
     std::optional<ShovelSpec> shovel;

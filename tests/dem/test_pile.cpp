@@ -1,0 +1,69 @@
+// The repose-angle fit against piles of known shape: a slope at a set angle between a flat top and a
+// flat run-out, with the spheres placed at random along it.
+#include "core/errors.h"
+#include "dem/pile.h"
+#include "dem/world.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace dipper;
+using namespace dipper::dem;
+
+namespace {
+
+/// A pile surface: top at 1.5 m up to x = 0.5, then down at `angle_deg` to 0.1 m, flat after; each
+/// 2 cm column along x gets a sphere of radius 0.05 m whose top lies on the surface, at random y, and
+/// spheres under it.
+World synthetic_pile(double angle_deg, std::uint64_t seed)
+{
+    World w(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    const MaterialIndex ore = w.materials().index_of("ore");
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> y(0.1, 0.9), jitter(0.0, 0.02);
+    const double t = std::tan(angle_deg * M_PI / 180.0), r = 0.05;
+    for (double x = 0.0; x < 5.0; x += 0.02) {
+        const double xs = x + jitter(rng);
+        const double surface = std::clamp(1.5 - t * (xs - 0.5), 0.1, 1.5);
+        for (double z = surface - r; z > 0.0; z -= 0.3) w.add_particle({{xs, y(rng), z}, {}, {}, r, ore});
+    }
+    return w;
+}
+
+}  // namespace
+
+TEST_CASE("the repose fit finds the slope of a pile of known angle and ignores its top and toe", "[dem][pile]")
+{
+    ReposeWindow window;
+    window.min_m = {0.0, 0.0, 0.0};
+    window.max_m = {5.0, 1.0, 3.0};
+    window.bin_m = 0.1;
+    for (const double angle : {20.0, 30.0, 34.7, 45.0}) {
+        const World w = synthetic_pile(angle, 7);
+        const ReposeFit fit = fit_repose_angle(w.particles(), window, "synthetic pile");
+        // each bin's top is the surface at a random point of the bin (within 2 cm of the bin's left edge
+        // plus the column spacing), so a bin reads up to tan(angle) x 0.1 m off; over 10+ bins the fitted
+        // slope is within a few tenths of a degree. Tolerance 0.5 deg.
+        CHECK(fit.angle_deg == Approx(angle).margin(0.5));
+        CHECK(fit.slope < 0.0);  // downhill along +x
+        CHECK(fit.bins_fitted >= 8);
+        CHECK(fit.rms_residual_m < 0.05);
+    }
+}
+
+TEST_CASE("the repose fit refuses a window without a slope and a bad window", "[dem][pile]")
+{
+    const World w = synthetic_pile(30.0, 1);
+    ReposeWindow flat;
+    flat.min_m = {4.0, 0.0, 0.0};  // the run-out only: every bin at the same height
+    flat.max_m = {5.0, 1.0, 3.0};
+    CHECK_THROWS_WITH(fit_repose_angle(w.particles(), flat, "flat part"), Catch::Contains("flat part") && Catch::Contains("bins lie on the slope"));
+    ReposeWindow bad = flat;
+    bad.along = 'z';
+    CHECK_THROWS_WITH(fit_repose_angle(w.particles(), bad, "window"), Catch::Contains("along = 'z'; expected x or y"));
+    bad = flat;
+    bad.max_m.x = 3.0;
+    CHECK_THROWS_WITH(fit_repose_angle(w.particles(), bad, "window"), Catch::Contains("max_m must exceed min_m"));
+}
