@@ -343,6 +343,23 @@ void RigidScene::track_passes()
     }
 }
 
+std::vector<std::pair<std::string, double>> RigidScene::wear_by_region(const SceneWear& w) const
+{
+    if (w.spec.part != "dipper") return {};
+    // the plates in make_dipper's order: bottom, lip, two sides, top, the teeth, then the wear bars
+    const std::size_t teeth = static_cast<std::size_t>(dipper_.parameters.tooth_count);
+    const auto region = [&](std::uint32_t plate) -> std::size_t {
+        if (plate <= 1) return plate;
+        if (plate <= 3) return 2;
+        if (plate == 4) return 3;
+        return plate < 5 + teeth ? 4 : 5;
+    };
+    std::vector<std::pair<std::string, double>> v{{"bottom", 0.0}, {"lip", 0.0}, {"sides", 0.0}, {"top", 0.0}, {"teeth", 0.0}, {"bars", 0.0}};
+    const std::vector<double>& volume = w.surface->triangle_volume_m3();
+    for (std::size_t t = 0; t < volume.size(); ++t) v[region(dipper_.body.triangle_plate[t])].second += volume[t];
+    return v;
+}
+
 double RigidScene::tonnage_t() const
 {
     double kg = 0.0;

@@ -77,6 +77,9 @@ public:
     /// Mass carried out of the dipper so far: the sum of the passes' masses, t.
     double tonnage_t() const;
     const std::vector<SceneWear>& wear() const { return wear_; }
+    /// The dipper's wear volume by part of it (bottom, lip, sides, top, teeth, bars), m^3; empty for other
+    /// parts.
+    std::vector<std::pair<std::string, double>> wear_by_region(const SceneWear& w) const;
     /// Pose of a wear surface's mesh frame in the world now.
     void wear_pose(const SceneWear& w, Mat3& rotation, Vec3& origin_m) const;
 

@@ -537,7 +537,15 @@ private:
             const double max_depth = depth.empty() ? 0.0 : *std::max_element(depth.begin(), depth.end());
             out << (k ? ", " : "") << "\"" << json_escape(w.spec.part) << "\": {\"law\": \"" << w.spec.law
                 << "\", \"constant\": " << json_number(w.spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
-                << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth) << "}";
+                << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth);
+            const auto regions = r.wear_by_region(w);
+            if (!regions.empty()) {
+                out << ", \"volume_by_region_m3\": {";
+                for (std::size_t g = 0; g < regions.size(); ++g)
+                    out << (g ? ", " : "") << "\"" << regions[g].first << "\": " << json_number(regions[g].second);
+                out << "}";
+            }
+            out << "}";
         }
         out << "}";
     }

@@ -278,7 +278,10 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
     for (std::size_t k = 1; k <= passes; ++k)
         out << ",pass" << k << "_mass_kg,pass" << k << "_fill_factor,pass" << k << "_mean_dig_force_N";
     if (first.shovel) out << ",tonnage_t";
-    for (const WearSpec& w : first.wear) out << ",wear_" << w.part << "_m3";
+    for (const WearSpec& w : first.wear) {
+        out << ",wear_" << w.part << "_m3";
+        if (w.part == "dipper") out << ",wear_dipper_bottom_m3,wear_dipper_lip_m3,wear_dipper_bars_m3";
+    }
     out << '\n';
     for (std::size_t v = 0; v < all.size(); ++v) {
         const std::string& s = summaries[v];
@@ -297,6 +300,10 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
         for (const WearSpec& w : first.wear) {
             const std::string part = wear.substr(std::min(wear.size(), wear.find("\"" + w.part + "\": {")));
             out << ',' << json_field(part, "volume_m3");
+            if (w.part == "dipper") {
+                const std::string by_region = part.substr(std::min(part.size(), part.find("\"volume_by_region_m3\"")));
+                for (const char* region : {"bottom", "lip", "bars"}) out << ',' << json_field(by_region, region);
+            }
         }
         out << '\n';
     }

@@ -15,6 +15,10 @@ assert summary["status"] == "completed", summary
 assert summary["rocks"] > 10, summary["rocks"]
 assert summary["passes"] == [], summary["passes"]
 assert "dipper" in summary["wear"] and summary["wear"]["dipper"]["law"] == "force_work", summary["wear"]
+by_region = summary["wear"]["dipper"]["volume_by_region_m3"]
+assert set(by_region) == {"bottom", "lip", "sides", "top", "teeth", "bars"}, by_region
+total = summary["wear"]["dipper"]["volume_m3"]
+assert total > 0 and abs(sum(by_region.values()) - total) <= 1e-9 * total, (by_region, total)
 
 
 def frames(pvd):
