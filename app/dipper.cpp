@@ -204,6 +204,7 @@ int sweep(const Options& o)
     if (!error.empty()) std::fprintf(stderr, "dipper: rank %d: %s\n", rank, error.c_str());
     if (rank == 0 && error.empty()) {
         write_sweep_table(sw, dir);
+        make_report(dir);
         std::printf("dipper sweep: %zu variants, %d did not complete; table: %s/sweep.csv\n", n, failed, dir.c_str());
     }
 #ifdef DIPPER_HAVE_MPI

@@ -1,4 +1,5 @@
-"""Writes DIR/report.md and its PNG figures from what `dipper run` left in DIR (summary.json, probes.csv).
+"""Writes DIR/report.md and its PNG figures from what `dipper run` left in DIR (summary.json, probes.csv),
+or DIR/sweep.md and sweep.png from what `dipper sweep` left there (sweep.csv).
 Usage: python3 report.py DIR"""
 import csv
 import json
@@ -6,6 +7,74 @@ import os
 import sys
 
 folder = sys.argv[1]
+
+
+def sweep_report(folder):
+    """A sweep folder: sweep.md with the table, and for one varied parameter sweep.png of the first pass's
+    mass and mean dig force (or the final mass) against it."""
+    with open(os.path.join(folder, "sweep.csv")) as f:
+        rows = list(csv.DictReader(f))
+    columns = list(rows[0].keys()) if rows else []
+    parameters = columns[1:columns.index("status")] if "status" in columns else []
+    shown = parameters + [c for c in ("status", "pass1_mass_kg", "pass1_fill_factor", "pass1_mean_dig_force_N",
+                                      "wear_dipper_m3", "wear_dipper_bottom_m3", "wear_dipper_bars_m3", "mass_kg")
+                          if c in columns]
+    lines = [f"# Sweep: {os.path.basename(os.path.abspath(folder))}", "", "| " + " | ".join(shown) + " |",
+             "|" + " --- |" * len(shown)]
+    for r in rows:
+        lines.append("| " + " | ".join(r[c] for c in shown) + " |")
+    lines.append("")
+    figures = 0
+    if len(parameters) == 1 and rows:
+        try:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+
+            key = parameters[0]
+            labels = [r[key] for r in rows]
+
+            def position(label):
+                text = label.strip("[] ")
+                try:
+                    return float(text.split(",")[0])  # a number, or the first component of a vector
+                except ValueError:
+                    return None
+
+            xs = [position(l) for l in labels]
+            categorical = any(x is None for x in xs)
+            if categorical:
+                xs = list(range(len(labels)))
+            quantities = [("pass1_mass_kg", "mass in the dipper, pass 1 [t]", 1e-3),
+                          ("pass1_mean_dig_force_N", "mean dig force, pass 1 [MN]", 1e-6)]
+            quantities = [q for q in quantities if q[0] in columns] or [("mass_kg", "mass [t]", 1e-3)]
+            fig, axes = plt.subplots(1, len(quantities), figsize=(4.2 * len(quantities), 3.4), dpi=110)
+            axes = axes if len(quantities) > 1 else [axes]
+            for ax, (column, label, scale) in zip(axes, quantities):
+                ys = [float(r[column]) * scale if r[column] not in ("", "null") else float("nan") for r in rows]
+                ax.plot(xs, ys, "o-", color="tab:blue")
+                ax.set_xlabel(key)
+                ax.set_ylabel(label)
+                if categorical:
+                    ax.set_xticks(xs)
+                    ax.set_xticklabels(labels)
+                ax.grid(True, alpha=0.3)
+            fig.tight_layout()
+            fig.savefig(os.path.join(folder, "sweep.png"))
+            plt.close(fig)
+            lines += ["![sweep](sweep.png)", ""]
+            figures = 1
+        except ImportError:
+            lines += ["matplotlib is not installed (Debian: python3-matplotlib), so this report has no figure.", ""]
+    with open(os.path.join(folder, "sweep.md"), "w") as f:
+        f.write("\n".join(lines))
+    print(f"report: {os.path.join(folder, 'sweep.md')} with {figures} figure{'s' if figures != 1 else ''}")
+
+
+if not os.path.exists(os.path.join(folder, "summary.json")) and os.path.exists(os.path.join(folder, "sweep.csv")):
+    sweep_report(folder)
+    sys.exit(0)
 summary = json.load(open(os.path.join(folder, "summary.json")))
 with open(os.path.join(folder, "probes.csv")) as f:
     rows = list(csv.DictReader(f))
