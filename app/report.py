@@ -179,7 +179,7 @@ if "passes" in summary:
     lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] |",
               "| --- | --- | --- | --- | --- | --- |"]
     for p in summary["passes"]:
-        lines.append(f"| {p['pass']} | {g(p['dig_start_s'])} to {g(p['dig_end_s'])} | {g(p['mass_kg'], 1e-3)} | "
+        lines.append(f"| {p['pass']} | {g(p.get('dig_start_s', p['start_s']))} to {g(p['dig_end_s'])} | {g(p['mass_kg'], 1e-3)} | "
                      f"{g(p['fill_factor'])} | {g(p['mean_dig_force_N'], 1e-6)} | {g(p['peak_dig_force_N'], 1e-6)} |")
     if not summary["passes"]:
         lines.append("| (no dump yet) | | | | | |")
