@@ -8,10 +8,12 @@
 #include "rigid/rope_shovel.h"
 #include "scenario/rigid_scene.h"
 #include "scenario/scenario.h"
+#include "scenario/sweep.h"
 
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <regex>
 
 using namespace dipper;
@@ -206,4 +208,47 @@ TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a
     scene.coupled().add_rock(cube, 3000.0, scene.rigid().material_index("rock"), dem->materials().index_of("rock"), centre);
     CHECK_THROWS_WITH(scene.check_tunnelling(), Catch::Contains("rock 0 (") && Catch::Contains("inside plate 0 of the dipper") &&
                                                     Catch::Contains("went through the steel") && Catch::Contains("Reduce time.step_s"));
+}
+
+TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and dig force, and the dipper's wear",
+          "[scenario][shovel]")
+{
+    const fs::path dir = fs::temp_directory_path() / "dipper_shovel_sweep_table";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "variant_000");
+    fs::create_directories(dir / "variant_001");
+    {
+        std::ofstream scenario(dir / "base.yaml");
+        scenario << base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12}\n");
+        std::ofstream sweep(dir / "sweep.yaml");
+        sweep << "dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: shovel.rake_angle_deg, values: [59.8, 63.8]}\n";
+    }
+    // the summaries two runs would leave: two passes in the first, one in the second
+    const auto summary = [&](const fs::path& file, const std::string& passes, double wear) {
+        std::ofstream out(file);
+        out << "{\n  \"name\": \"x\",\n  \"status\": \"completed\",\n  \"time_s\": 60,\n  \"steps\": 10,\n  \"particles\": 5,\n"
+            << "  \"mass_kg\": 1000,\n  \"kinetic_energy_J\": 1,\n  \"region_mass_kg\": {},\n  \"state_hash\": \"ab\",\n"
+            << "  \"passes\": [" << passes << "\n  ],\n  \"tonnage_t\": 150,\n  \"wear\": {\"dipper\": {\"law\": \"force_work\", "
+            << "\"constant\": 1e-12, \"volume_m3\": " << wear << ", \"max_depth_mm\": 0.1, \"volume_by_region_m3\": {\"bottom\": 0.25, "
+            << "\"lip\": 0.125, \"sides\": 0, \"top\": 0, \"teeth\": 0, \"bars\": 0}}}\n}\n";
+    };
+    summary(dir / "variant_000" / "summary.json",
+            "\n    {\"pass\": 1, \"mass_kg\": 80000, \"fill_factor\": 1.0, \"mean_dig_force_N\": 4200000},"
+            "\n    {\"pass\": 2, \"mass_kg\": 70000, \"fill_factor\": 0.875, \"mean_dig_force_N\": 3900000}",
+            0.5);
+    summary(dir / "variant_001" / "summary.json", "\n    {\"pass\": 1, \"mass_kg\": 85000, \"fill_factor\": 1.0625, \"mean_dig_force_N\": 4300000}",
+            0.75);
+    const Sweep sw = load_sweep((dir / "sweep.yaml").string());
+    write_sweep_table(sw, dir.string());
+    std::ifstream in(dir / "sweep.csv");
+    std::string header, first, second;
+    std::getline(in, header);
+    std::getline(in, first);
+    std::getline(in, second);
+    CHECK_THAT(header, Catch::EndsWith("pass1_mass_kg,pass1_fill_factor,pass1_mean_dig_force_N,pass2_mass_kg,pass2_fill_factor,"
+                                       "pass2_mean_dig_force_N,tonnage_t,wear_dipper_m3,wear_dipper_bottom_m3,wear_dipper_lip_m3,"
+                                       "wear_dipper_bars_m3"));
+    CHECK_THAT(first, Catch::StartsWith("0,\"59.8\",completed,") && Catch::EndsWith(",80000,1.0,4200000,70000,0.875,3900000,150,0.5,0.25,0.125,0"));
+    CHECK_THAT(second, Catch::StartsWith("1,\"63.8\",completed,") && Catch::EndsWith(",85000,1.0625,4300000,,,,150,0.75,0.25,0.125,0"));
+    fs::remove_all(dir);
 }
