@@ -186,6 +186,33 @@ if "passes" in summary:
 for part, w in summary.get("wear", {}).items():
     lines += ["", f"Wear of {part} ({w['law']}, constant {g(w['constant'])}): volume {g(w['volume_m3'])} m³, "
               f"deepest {g(w['max_depth_mm'])} mm."]
+    m = w.get("measured")
+    points_csv = os.path.join(folder, f"wear_{part}_points.csv")
+    if m:
+        lines += ["", f"Measured at {m['points']} points: mean {g(m['mean_measured_mm_per_t'])} mm/t against "
+                  f"{g(m['mean_simulated_mm_per_t'])} mm/t simulated (correlation {g(m['correlation'])}); the constant that "
+                  f"makes the means agree is {g(m['calibrated_constant'])} ({g(m['calibrated_constant_low'])} to "
+                  f"{g(m['calibrated_constant_high'])} within the gauge and position uncertainty), {g(m['scale'])} times "
+                  f"the one used. Per point: `wear_{part}_points.csv`."]
+        if os.path.exists(points_csv) and note == "":
+            with open(points_csv) as f:
+                pts = list(csv.DictReader(f))
+            measured = [float(p["measured_mm_per_t"]) for p in pts]
+            simulated = [float(p["simulated_mm_per_t"]) for p in pts]
+            fig, ax = plt.subplots(figsize=(4.6, 4.2), dpi=110)
+            ax.plot(measured, simulated, "o", label=f"constant {g(w['constant'])}")
+            ax.plot(measured, [x * m["scale"] for x in simulated], "s", label=f"calibrated {g(m['calibrated_constant'])}")
+            top = max(measured + [x * m["scale"] for x in simulated]) * 1.1
+            ax.plot([0, top], [0, top], "k--", linewidth=0.8)
+            ax.set_xlabel("measured wear rate [mm/t]")
+            ax.set_ylabel("simulated wear rate [mm/t]")
+            ax.set_title(f"Measured and simulated wear: {part}")
+            ax.legend(fontsize=8)
+            ax.grid(True, alpha=0.3)
+            fig.tight_layout()
+            fig.savefig(os.path.join(folder, f"wear_{part}_measured.png"))
+            plt.close(fig)
+            figures.append((f"Measured and simulated wear of {part}", f"wear_{part}_measured.png"))
     if os.path.exists(os.path.join(folder, f"wear_{part}_map.png")):
         figures.append((f"Wear rate of {part} (mm/t, seen from +z of the part)", f"wear_{part}_map.png"))
 lines.append("")

@@ -107,6 +107,9 @@ const std::vector<KeySpec>& scenario_keys()
         {"wear[].constant", "number", "required", "the law's constant: K (archard, m3/(N m)), phi (force_work, m3/J), "
                                                   "K (impact_energy, m3/J); finnie: the flow stress, Pa"},
         {"wear[].smoothing_iterations", "integer", "2", "volume-conserving smoothing of the nodal wear (thesis Paper B 3.4)"},
+        {"wear[].tonnage_t", "number", "0", "material that passed over the part in the run, for mm/t; 0 takes the shovel's passes"},
+        {"wear[].measured_file", "string", "none",
+         "measured wear: CSV of id, x_m, y_m, z_m (part frame), depth_mm, tonnage_t; the run compares and calibrates against it"},
 
         {"probes", "map", "{}", "quantities written to probes.csv besides the standard columns"},
         {"probes.regions", "list", "[]", "boxes whose particle mass is recorded (particles by centre)"},

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "coupling/mixed_bed.h"
+#include "wear/calibration.h"
 #include "meshes/vtk_surface.h"
 
 #include <algorithm>
@@ -171,6 +172,14 @@ void RigidScene::add_wear(const Scenario& s)
         }
         w.surface = std::make_unique<wear::WearSurface>(spec.part, std::move(mesh),
                                                         wear::WearLaw::from_name(spec.law, spec.constant, spec.where), w.wall);
+        if (!spec.measured_file.empty())
+            for (const wear::MeasuredPoint& p : wear::read_measured_points(spec.measured_file)) {
+                const double d = wear::locate_on_surface(w.surface->mesh(), p.position_m).distance_m;
+                if (d > kMeasuredPointTolerance_m)
+                    throw InputError(concat(p.source, ": measured point '", p.id, "' at (", p.position_m.x, ", ", p.position_m.y, ", ",
+                                            p.position_m.z, ") m is ", d, " m from the surface of '", spec.part,
+                                            "' (in the part's own frame); expected within ", kMeasuredPointTolerance_m, " m"));
+            }
         wear_.push_back(std::move(w));
     }
     if (!wear_.empty())

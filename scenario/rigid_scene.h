@@ -15,6 +15,9 @@
 
 namespace dipper::scenario {
 
+/// How far a measured wear point may lie from its part's surface, m.
+inline constexpr double kMeasuredPointTolerance_m = 0.1;
+
 /// One pass of the shovel: from the end of the previous dump (or t = 0) to the moment its door opens.
 struct PassRecord {
     double start_s = 0.0;
@@ -76,6 +79,8 @@ public:
     const std::vector<PassRecord>& passes() const { return passes_; }
     /// Mass carried out of the dipper so far: the sum of the passes' masses, t.
     double tonnage_t() const;
+    /// The tonnage a wear surface's rates divide by: its tonnage_t key, or the passes' tonnage.
+    double tonnage_t(const SceneWear& w) const { return w.spec.tonnage_t > 0.0 ? w.spec.tonnage_t : tonnage_t(); }
     const std::vector<SceneWear>& wear() const { return wear_; }
     /// The dipper's wear volume by part of it (bottom, lip, sides, top, teeth, bars), m^3; empty for other
     /// parts.

@@ -5,6 +5,7 @@
 #include "core/state_io.h"
 #include "dem/output.h"
 #include "scenario/rigid_scene.h"
+#include "wear/calibration.h"
 #include "wear/wear_output.h"
 
 #include <algorithm>
@@ -236,7 +237,10 @@ public:
             result.message = e.what();
         }
         if (options_.progress) progress(start, first_step, terminal, true);
-        if (rigid_) write_wear_maps();
+        if (rigid_) {
+            write_wear_maps();
+            compare_measured_wear();  // the points were checked against the surfaces before the run
+        }
         result.time_s = world_->time_s();
         result.steps = world_->step_count();
         write_summary(result, start);
@@ -379,7 +383,7 @@ private:
                 Mat3 r;
                 Vec3 o;
                 rigid_->wear_pose(sw, r, o);
-                wear::write_wear_vtp(*sw.surface, dir_ + "/" + wear_file, rigid_->tonnage_t(), sw.spec.smoothing_iterations, r, o);
+                wear::write_wear_vtp(*sw.surface, dir_ + "/" + wear_file, rigid_->tonnage_t(sw), sw.spec.smoothing_iterations, r, o);
                 wear_pvd_[k]->add(world_->time_s(), wear_file);
             }
         ++snapshot_index_;
@@ -394,17 +398,35 @@ private:
     /// from inside, a floor), once material has passed; a part with no face towards +z gets none.
     void write_wear_maps()
     {
-        if (!(rigid_->tonnage_t() > 0.0)) return;
         for (const SceneWear& sw : rigid_->wear()) {
+            if (!(rigid_->tonnage_t(sw) > 0.0)) continue;
             wear::MapView view;
             // the dipper's bottom, seen from inside: its top plate's outside lies above it
             if (sw.spec.part == "dipper") view.max_along_view_m = rigid_->dipper().parameters.height_m / 2.0;
             try {
-                wear::write_wear_map_png(*sw.surface, dir_ + "/wear_" + sw.spec.part + "_map.png", rigid_->tonnage_t(),
+                wear::write_wear_map_png(*sw.surface, dir_ + "/wear_" + sw.spec.part + "_map.png", rigid_->tonnage_t(sw),
                                          sw.spec.smoothing_iterations, view);
             } catch (const InputError&) {
                 // no triangle of the part faces +z: no map
             }
+        }
+    }
+
+    /// With a measurement file: the measured against the simulated rates at the points, and the wear
+    /// constant that makes their means agree (wear/calibration.h); written to wear_<part>_points.csv.
+    void compare_measured_wear()
+    {
+        calibrations_.clear();
+        for (const SceneWear& sw : rigid_->wear()) {
+            if (sw.spec.measured_file.empty() || !(rigid_->tonnage_t(sw) > 0.0)) {
+                calibrations_.emplace_back();
+                continue;
+            }
+            const auto points = wear::read_measured_points(sw.spec.measured_file);
+            const wear::CalibrationResult c = wear::calibrate(*sw.surface, rigid_->tonnage_t(sw), sw.spec.smoothing_iterations, points,
+                                                              wear::MeasurementUncertainty{}, kMeasuredPointTolerance_m);
+            wear::write_points_csv(dir_ + "/wear_" + sw.spec.part + "_points.csv", c.before);
+            calibrations_.push_back(c);
         }
     }
 
@@ -535,7 +557,8 @@ private:
             const SceneWear& w = r.wear()[k];
             const std::vector<double> depth = w.surface->node_depth_m(w.spec.smoothing_iterations);
             const double max_depth = depth.empty() ? 0.0 : *std::max_element(depth.begin(), depth.end());
-            out << (k ? ", " : "") << "\"" << json_escape(w.spec.part) << "\": {\"law\": \"" << w.spec.law
+            out << (k ? ", " : "") << "\"" << json_escape(w.spec.part) << "\": {\"tonnage_t\": " << json_number(r.tonnage_t(w))
+                << ", \"law\": \"" << w.spec.law
                 << "\", \"constant\": " << json_number(w.spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
                 << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth);
             const auto regions = r.wear_by_region(w);
@@ -544,6 +567,15 @@ private:
                 for (std::size_t g = 0; g < regions.size(); ++g)
                     out << (g ? ", " : "") << "\"" << regions[g].first << "\": " << json_number(regions[g].second);
                 out << "}";
+            }
+            if (k < calibrations_.size() && calibrations_[k].scale > 0.0) {
+                const wear::CalibrationResult& c = calibrations_[k];
+                out << ", \"measured\": {\"points\": " << c.before.size() << ", \"mean_measured_mm_per_t\": "
+                    << json_number(c.summary_before.mean_measured) << ", \"mean_simulated_mm_per_t\": "
+                    << json_number(c.summary_before.mean_simulated) << ", \"correlation\": " << json_number(c.summary_before.correlation)
+                    << ", \"scale\": " << json_number(c.scale) << ", \"calibrated_constant\": " << json_number(c.calibrated_constant)
+                    << ", \"calibrated_constant_low\": " << json_number(c.constant_low)
+                    << ", \"calibrated_constant_high\": " << json_number(c.constant_high) << "}";
             }
             out << "}";
         }
@@ -555,6 +587,7 @@ private:
     RunOptions options_;
     std::unique_ptr<dem::World> world_;
     std::unique_ptr<RigidScene> rigid_;  ///< rocks, shovel and wear; null for spheres and walls only
+    std::vector<wear::CalibrationResult> calibrations_;  ///< per wear surface, at the end (scale 0: none)
     std::vector<int> walls_;             ///< the walls outputs list
     std::vector<dem::Pourer> pourers_;
     std::unique_ptr<dem::PvdCollection> particles_pvd_;

@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "meshes/mesh_io.h"
 #include "scenario/keys.h"
+#include "wear/calibration.h"
 #include "wear/laws.h"
 
 #include <yaml-cpp/yaml.h>
@@ -504,6 +505,18 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         const std::int64_t it = w.integer("smoothing_iterations");
         if (it < 0 || it > 100) w.fail("smoothing_iterations", concat(it), "0 to 100");
         spec.smoothing_iterations = static_cast<int>(it);
+        spec.tonnage_t = w.number("tonnage_t");
+        require_non_negative(spec.tonnage_t, "tonnage_t", w.where("tonnage_t"));
+        if (const auto file = w.optional_text("measured_file")) {
+            const std::filesystem::path path = std::filesystem::path(*file).is_absolute() ? std::filesystem::path(*file)
+                                                                                          : std::filesystem::path(s.base_dir) / *file;
+            spec.measured_file = path.string();
+            try {
+                (void)wear::read_measured_points(spec.measured_file);  // its errors name file, line and column
+            } catch (const InputError& e) {
+                throw InputError(concat(w.where("measured_file"), ": ", e.what()));
+            }
+        }
         s.wear.push_back(spec);
     }
 

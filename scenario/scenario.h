@@ -81,6 +81,8 @@ struct WearSpec {
     std::string part, law;
     double constant = 0.0;
     int smoothing_iterations = 2;
+    double tonnage_t = 0.0;       ///< 0: the shovel's passes
+    std::string measured_file;    ///< absolute path, or empty
     std::string where;
 };
 

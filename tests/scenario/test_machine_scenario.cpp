@@ -7,6 +7,7 @@
 #include "rigid/motion_curves.h"
 #include "rigid/rope_shovel.h"
 #include "scenario/rigid_scene.h"
+#include "scenario/runner.h"
 #include "scenario/scenario.h"
 #include "scenario/sweep.h"
 
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 
 using namespace dipper;
 using namespace dipper::scenario;
@@ -251,4 +253,50 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and di
     CHECK_THAT(first, Catch::StartsWith("0,\"59.8\",completed,") && Catch::EndsWith(",80000,1.0,4200000,70000,0.875,3900000,150,0.5,0.25,0.125,0"));
     CHECK_THAT(second, Catch::StartsWith("1,\"63.8\",completed,") && Catch::EndsWith(",85000,1.0625,4300000,,,,150,0.75,0.25,0.125,0"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("measured wear: compared and calibrated at the end of a run; points off the part are refused before it",
+          "[scenario][wear]")
+{
+    const std::string file = std::string(DIPPER_SOURCE_DIR) + "/tests/data/scenarios/wear_floor.yaml";
+    const std::string dir = (fs::temp_directory_path() / "dipper_wear_floor").string();
+    fs::remove_all(dir);
+    RunOptions o;
+    o.progress = false;
+    const RunResult r = run_scenario(load_scenario(file), dir, o);
+    REQUIRE(r.status == RunStatus::completed);
+    std::ifstream in(dir + "/summary.json");
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string s = text.str();
+    const auto number = [&](const std::string& key) {
+        std::smatch m;
+        REQUIRE(std::regex_search(s, m, std::regex("\"" + key + "\": ([-0-9.eE+]+)")));
+        return std::stod(m[1]);
+    };
+    CHECK(number("points") == 4);
+    // the file's rates: 0.2, 0.3, 0.2, 0.4 mm over 0.3 t
+    CHECK(number("mean_measured_mm_per_t") == Approx((0.2 + 0.3 + 0.2 + 0.4) / 4.0 / 0.3).epsilon(1e-9));
+    const double simulated = number("mean_simulated_mm_per_t");
+    CHECK(simulated > 0.0);
+    // the calibration scales the constant so that the means agree
+    CHECK(number("scale") == Approx(number("mean_measured_mm_per_t") / simulated).epsilon(1e-6));
+    CHECK(number("calibrated_constant") == Approx(1.0e-12 * number("scale")).epsilon(1e-6));
+    std::ifstream points(dir + "/wear_floor_points.csv");
+    std::string line;
+    int rows = 0;
+    while (std::getline(points, line)) ++rows;
+    CHECK(rows == 5);  // header and four points
+
+    // a point 0.5 m above the floor belongs to no part: refused before anything runs
+    const fs::path bad = fs::temp_directory_path() / "dipper_wear_floor_bad.csv";
+    {
+        std::ofstream out(bad);
+        out << "id,x_m,y_m,z_m,depth_mm,tonnage_t\nhigh,0,0,0.5,0.1,1\n";
+    }
+    Scenario sc = load_scenario(file);
+    sc.wear[0].measured_file = bad.string();
+    CHECK_THROWS_WITH(run_scenario(sc, dir, o), Catch::Contains("measured point 'high'") && Catch::Contains("0.5 m from the surface of 'floor'"));
+    fs::remove_all(dir);
+    fs::remove(bad);
 }
