@@ -1,6 +1,7 @@
 #include "scenario/scenario.h"
 
 #include "core/errors.h"
+#include "meshes/machine_geometry.h"
 #include "meshes/mesh_io.h"
 #include "scenario/keys.h"
 #include "wear/calibration.h"
@@ -435,10 +436,22 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         MeshSpec mesh;
         mesh.where = m.where("file");
         mesh.name = m.text("name");
-        mesh.file = m.text("file");
+        mesh.file = m.optional_text("file").value_or("");
+        mesh.part = m.optional_text("part").value_or("");
+        if (mesh.file.empty() == mesh.part.empty())
+            m.fail(mesh.file.empty() ? "file" : "part", mesh.file.empty() ? "neither file nor part" : "both file and part",
+                   "a mesh file or a generated part, one of the two");
+        if (!mesh.part.empty()) {
+            mesh.where = m.where("part");
+            if (mesh.part != "truck_body" && mesh.part != "feeder_pan" && mesh.part != "feeder_bin")
+                m.fail("part", concat("\"", mesh.part, "\""), "truck_body, feeder_pan or feeder_bin");
+        }
+        mesh.element_size_m = m.number("element_size_m");
+        require_in_range(mesh.element_size_m, 0.02, 2.0, "element_size_m", m.where("element_size_m"));
         mesh.material = material_known(s, m, "material", true);
         mesh.scale = m.number("scale");
         require_positive(mesh.scale, "scale", m.where("scale"));
+        mesh.rotate_deg = m.vector3("rotate_deg");
         mesh.translate_m = m.vector3("translate_m");
         if (m.has("motion")) {
             const MapReader mo = m.map("motion");
@@ -581,18 +594,37 @@ std::unique_ptr<dem::World> build_world(const Scenario& s)
     auto world = std::make_unique<dem::World>(s.materials, settings);
     for (const PlaneSpec& p : s.planes) world->add_plane(p.point_m, p.normal, s.materials.index_of(p.material), p.name);
     for (const MeshSpec& m : s.meshes) {
-        const std::filesystem::path file = std::filesystem::path(m.file).is_absolute()
-                                               ? std::filesystem::path(m.file)
-                                               : std::filesystem::path(s.base_dir) / m.file;
         meshes::TriangleMesh mesh;
+        std::string source;
         try {
-            mesh = meshes::load_triangle_mesh(file.string(), m.scale);
+            if (!m.part.empty()) {
+                meshes::FeederParameters feeder;
+                feeder.element_size_m = m.element_size_m;
+                meshes::TruckBodyParameters truck;
+                truck.element_size_m = m.element_size_m;
+                mesh = m.part == "truck_body" ? meshes::make_truck_body(truck).surface
+                       : m.part == "feeder_pan" ? meshes::make_feeder(feeder).pan.surface
+                                                : meshes::make_feeder(feeder).bin.surface;
+                source = concat("generated ", m.part);
+                std::vector<Vec3> scaled = mesh.vertices_m();
+                for (Vec3& v : scaled) v = v * m.scale;
+                mesh = meshes::TriangleMesh(std::move(scaled), mesh.triangles(), source);
+            } else {
+                const std::filesystem::path file = std::filesystem::path(m.file).is_absolute()
+                                                       ? std::filesystem::path(m.file)
+                                                       : std::filesystem::path(s.base_dir) / m.file;
+                source = file.string();
+                mesh = meshes::load_triangle_mesh(source, m.scale);
+            }
         } catch (const InputError& e) {
             throw InputError(concat(m.where, ": ", e.what()));
         }
+        const Mat3 turn = rotation_about_axis({0, 0, 1}, m.rotate_deg.z * M_PI / 180.0) *
+                          rotation_about_axis({0, 1, 0}, m.rotate_deg.y * M_PI / 180.0) *
+                          rotation_about_axis({1, 0, 0}, m.rotate_deg.x * M_PI / 180.0);
         std::vector<Vec3> vertices = mesh.vertices_m();
-        for (Vec3& v : vertices) v += m.translate_m;
-        mesh = meshes::TriangleMesh(std::move(vertices), mesh.triangles(), file.string());
+        for (Vec3& v : vertices) v = turn * v + m.translate_m;
+        mesh = meshes::TriangleMesh(std::move(vertices), mesh.triangles(), source);
         world->add_mesh(std::move(mesh), s.materials.index_of(m.material), m.name, m.motion);
     }
     return world;

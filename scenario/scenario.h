@@ -24,7 +24,10 @@ struct PlaneSpec {
 
 struct MeshSpec {
     std::string name, file, material;  ///< file: absolute, or relative to Scenario::base_dir
+    std::string part;                  ///< a generated part instead of a file (truck_body, feeder_pan, feeder_bin)
+    double element_size_m = 0.15;      ///< of a generated part
     double scale = 1.0;
+    Vec3 rotate_deg;
     Vec3 translate_m;
     std::optional<dem::PrescribedMotion> motion;
     std::string where;                 ///< file:line:col of the entry, for errors found when loading the mesh

@@ -83,6 +83,28 @@ TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the
     CHECK_THAT(e, Catch::Contains("wear[0].law") && Catch::Contains("unknown wear law 'hertz'"));
     e = error_of(base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12}\n  - {part: dipper, constant: 1.0e-12}\n"));
     CHECK_THAT(e, Catch::Contains("wear[1].part") && Catch::Contains("each part once"));
+    // generated parts instead of mesh files, turned and placed
+    const Scenario g = parse_scenario(base("meshes:\n  - {name: truck, part: truck_body, material: truck, rotate_deg: [0, 0, 90], "
+                                           "translate_m: [0, 20, 0], element_size_m: 0.3}\n"),
+                                      "case.yaml", ".");
+    REQUIRE(g.meshes.size() == 1);
+    const auto world = build_world(g);
+    const meshes::TriangleMesh& truck = world->mesh_wall(1).mesh();
+    // turned 90 deg about z, the body's x becomes y and its y becomes -x; then moved 20 m along y
+    meshes::TruckBodyParameters tp;
+    tp.element_size_m = 0.3;
+    const meshes::TriangleMesh own = meshes::make_truck_body(tp).surface;
+    CHECK(truck.triangle_count() == own.triangle_count());
+    CHECK(truck.bounds_min_m().y == Approx(20.0 + own.bounds_min_m().x).margin(1e-9));
+    CHECK(truck.bounds_max_m().y == Approx(20.0 + own.bounds_max_m().x).margin(1e-9));
+    CHECK(truck.bounds_min_m().x == Approx(-own.bounds_max_m().y).margin(1e-9));
+    CHECK(truck.bounds_max_m().z == Approx(own.bounds_max_m().z).margin(1e-9));
+    e = error_of(base("meshes:\n  - {name: t, part: truck_body, file: t.stl, material: truck}\n"));
+    CHECK_THAT(e, Catch::Contains("meshes[0].part: got both file and part; expected a mesh file or a generated part"));
+    e = error_of(base("meshes:\n  - {name: t, material: truck}\n"));
+    CHECK_THAT(e, Catch::Contains("meshes[0].file: got neither file nor part"));
+    e = error_of(base("meshes:\n  - {name: t, part: crusher, material: truck}\n"));
+    CHECK_THAT(e, Catch::Contains("meshes[0].part: got \"crusher\"; expected truck_body, feeder_pan or feeder_bin"));
     e = error_of(base("coupling: {substeps: 0}\n"));
     CHECK_THAT(e, Catch::Contains("coupling.substeps: got 0"));
 
