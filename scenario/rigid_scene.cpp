@@ -57,6 +57,12 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
     settings.gravity_m_per_s2 = s.gravity_m_per_s2;
     rigid_ = std::make_unique<rigid::RigidWorld>(settings);
     rigid::add_aitik_copper_ore_materials(*rigid_);
+    // the DEM preset's other surfaces, with the same friction against rocks as against spheres (Table 2:
+    // FE truck-DE 0.85; DE-remaining 0, the frictionless walls of calibration boxes)
+    rigid_->add_material("truck");
+    rigid_->add_material("steel");
+    rigid_->set_pair("rock", "truck", 0.85, 0.0);
+    rigid_->set_pair("rock", "steel", 0.0, 0.0);
     coupled_ = std::make_unique<coupling::CoupledWorld>(dem, *rigid_, coupling::CouplingSettings{s.coupling_substeps});
     bool rocks = false;
     for (const FillSpec& f : s.fills) rocks = rocks || !f.rocks.empty();
@@ -68,7 +74,7 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
         if (m < 0 && rocks)
             throw InputError(concat(s.source, ": rocks meet wall '", wall, "' of material '", material,
                                     "', which has no rock coefficients in the rigid world; give it one of the rigid materials "
-                                    "rock, ground, bucket"));
+                                    "rock, ground, bucket, truck, steel"));
         return m;
     };
     for (const PlaneSpec& p : s.planes) {
@@ -79,17 +85,21 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
     }
     for (std::size_t k = 0; k < s.meshes.size(); ++k) {
         const MeshSpec& spec = s.meshes[k];
-        if (spec.motion) {
-            if (rocks)
-                throw InputError(concat(spec.where, ": mesh wall '", spec.name,
-                                        "' moves, and rocks do not yet collide with moving mesh walls; "
-                                        "use spheres only, or a fixed wall"));
-            continue;
-        }
         const int m = rigid_material(spec.name, spec.material);
         if (m < 0) continue;
         const int wall = static_cast<int>(s.planes.size() + k);
-        static_meshes_.emplace_back(spec.name, rigid_->add_static_mesh(dem.mesh_wall(wall).mesh(), m, spec.name));
+        const dem::MeshWall& mesh = dem.mesh_wall(wall);
+        if (spec.motion) {
+            // a moving wall is a kinematic body in Bullet that step() places where the DEM wall will be
+            Mat3 r;
+            Vec3 t;
+            spec.motion->pose(0.0, r, t);
+            const rigid::BodyId body = rigid_->add_kinematic_mesh(mesh.mesh(), m, spec.name, r, t);
+            moving_meshes_.push_back({body, *spec.motion});
+            static_meshes_.emplace_back(spec.name, body);
+            continue;
+        }
+        static_meshes_.emplace_back(spec.name, rigid_->add_static_mesh(mesh.mesh(), m, spec.name));
     }
 
     if (s.shovel) {
@@ -237,6 +247,14 @@ void RigidScene::check_tunnelling() const
 
 void RigidScene::step()
 {
+    // moving walls: Bullet's step ends at t + the coupling step, where the prescribed motion puts them
+    const double t_next = coupled_->time_s() + coupled_->coupling_step_s();
+    for (const auto& [body, motion] : moving_meshes_) {
+        Mat3 r;
+        Vec3 t;
+        motion.pose(t_next, r, t);
+        rigid_->set_kinematic_pose(body, r, t);
+    }
     coupled_->step();
     check_tunnelling();
     const double dt = coupled_->coupling_step_s();

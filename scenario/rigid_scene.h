@@ -112,6 +112,7 @@ private:
     rigid::BodyId dipper_body_ = -1, door_body_ = -1;
     int dipper_wall_ = -1, door_wall_ = -1;
     std::vector<std::pair<std::string, rigid::BodyId>> static_meshes_;  ///< scenario mesh name, Bullet body
+    std::vector<std::pair<rigid::BodyId, dem::PrescribedMotion>> moving_meshes_;  ///< kinematic in Bullet
     std::size_t scenario_walls_ = 0;  ///< DEM walls 0 .. n-1 are the scenario's planes and meshes
     std::vector<SceneWear> wear_;
     std::vector<PassRecord> passes_;
