@@ -279,23 +279,31 @@ constexpr const char* kStateMagic = "dipper-state";
 constexpr int kStateVersion = 1;
 }  // namespace
 
-void save_state(const CoupledWorld& world, const std::string& path)
+void save_state(const CoupledWorld& world, const std::string& path, double cut_above_m)
 {
+    if (std::isnan(cut_above_m)) throw InputError(concat("save_state '", path, "': the cut height is not a number"));
     std::ofstream out = open_for_writing(path);
     out << std::setprecision(17);
     const dem::World& dem = world.dem();
     const auto& p = dem.particles();
     out << kStateMagic << ' ' << kStateVersion << '\n';
-    out << "spheres " << p.size() << '\n';
     std::vector<std::size_t> by_id(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) by_id[p.id[i]] = i;
-    for (std::size_t i : by_id) {
+    std::vector<std::size_t> kept;
+    for (std::size_t i : by_id)
+        if (p.position_m[i].z <= cut_above_m) kept.push_back(i);
+    std::vector<const RockRecord*> rocks;
+    for (const RockRecord& r : world.rocks())
+        if (world.rigid().state(r.body).position_m.z <= cut_above_m) rocks.push_back(&r);
+    out << "spheres " << kept.size() << '\n';
+    for (std::size_t i : kept) {
         const Vec3 x = p.position_m[i], v = p.velocity_m_per_s[i], w = p.angular_velocity_rad_per_s[i];
         out << x.x << ' ' << x.y << ' ' << x.z << ' ' << v.x << ' ' << v.y << ' ' << v.z << ' ' << w.x << ' ' << w.y << ' '
             << w.z << ' ' << p.radius_m[i] << ' ' << dem.materials().material(p.material[i]).name << '\n';
     }
-    out << "rocks " << world.rocks().size() << '\n';
-    for (const RockRecord& r : world.rocks()) {
+    out << "rocks " << rocks.size() << '\n';
+    for (const RockRecord* rock : rocks) {
+        const RockRecord& r = *rock;
         const rigid::BodyState s = world.rigid().state(r.body);
         out << "rock " << r.density_kg_per_m3 << ' ' << world.rigid().material_name(r.rigid_material) << ' '
             << dem.materials().material(r.dem_material).name << ' ' << r.shape.vertices_m().size() << ' '

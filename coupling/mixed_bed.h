@@ -5,6 +5,7 @@
 #include "coupling/coupled_world.h"
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -53,8 +54,10 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo_m, const Vec3& hi
                            const MixedMaterials& materials, double total_mass_kg, std::uint64_t seed, int attempts = 20000);
 
 /// Writes the spheres (position, velocity, spin, radius, material) and the rocks made with add_rock (shape,
-/// density, materials, pose, velocities) to a versioned text file, full precision.
-void save_state(const CoupledWorld& world, const std::string& path);
+/// density, materials, pose, velocities) to a versioned text file, full precision. Only spheres whose
+/// centre and rocks whose centroid lie at or below `cut_above_m` are written (a pile cut at a height).
+void save_state(const CoupledWorld& world, const std::string& path,
+                double cut_above_m = std::numeric_limits<double>::infinity());
 
 /// Adds the spheres and rocks of a saved state to the worlds (materials matched by name). Errors name the
 /// file, the line and what was expected.

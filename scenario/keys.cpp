@@ -59,6 +59,9 @@ const std::vector<KeySpec>& scenario_keys()
         {"meshes[].motion.oscillation_amplitude_m", "vector3", "[0, 0, 0]", "A in pivot + v t + A sin(2 pi f t)"},
         {"meshes[].motion.oscillation_frequency_Hz", "number", "0", "f of the oscillation"},
 
+        {"pile", "string", "none",
+         "a saved pile (output.pile_file of an earlier run), relative to this file: its spheres and rocks are placed at t = 0, "
+         "before the fills"},
         {"fills", "list", "[]", "particles placed at t = 0, seeded random and non-overlapping"},
         {"fills[].material", "string", "ore", "particle material"},
         {"fills[].mass_kg", "number", "required", "total mass to place"},
@@ -131,6 +134,9 @@ const std::vector<KeySpec>& scenario_keys()
         {"output.checkpoint_interval_s", "number", "0",
          "simulated seconds between checkpoints; 0: only on SIGINT/SIGTERM and at the end"},
         {"output.progress_interval_s", "number", "10", "wall-clock seconds between progress lines when not on a terminal"},
+        {"output.pile_file", "string", "none", "at the end of a completed run, the spheres and rocks are saved to this file in the "
+                                               "output folder, for a later scenario's pile key"},
+        {"output.pile_cut_above_m", "number", "1e9", "only spheres whose centre and rocks whose centroid lie at or below this height are saved"},
     };
     return keys;
 }

@@ -4,6 +4,7 @@
 #include "core/files.h"
 #include "core/state_io.h"
 #include "dem/output.h"
+#include "coupling/mixed_bed.h"
 #include "scenario/rigid_scene.h"
 #include "wear/calibration.h"
 #include "wear/wear_output.h"
@@ -114,6 +115,7 @@ public:
         }
         world_ = build_world(scenario_);
         if (scenario_.uses_coupling()) rigid_ = std::make_unique<RigidScene>(scenario_, *world_);
+        if (!scenario_.pile.empty()) coupling::load_state(rigid_->coupled(), scenario_.pile);  // errors name file and line
         build_particles(scenario_, *world_);
         if (rigid_) {
             rigid_->fill_mixed(scenario_);
@@ -231,6 +233,8 @@ public:
             if (result.status == RunStatus::completed) {
                 if (scenario_.output.csv_interval_s > 0.0 && last_row_step_ != world_->step_count()) write_row();
                 checkpoint();
+                if (!scenario_.output.pile_file.empty())
+                    coupling::save_state(rigid_->coupled(), dir_ + "/" + scenario_.output.pile_file, scenario_.output.pile_cut_above_m);
             }
         } catch (const SimulationError& e) {
             result.status = RunStatus::diverged;

@@ -477,6 +477,13 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
                     throw InputError(concat(s.source, ": wall name '", names[a], "' is used twice; planes and meshes need unique names"));
     }
 
+    if (const auto pile = top.optional_text("pile")) {
+        const std::filesystem::path path = std::filesystem::path(*pile).is_absolute() ? std::filesystem::path(*pile)
+                                                                                      : std::filesystem::path(s.base_dir) / *pile;
+        if (!std::filesystem::exists(path))
+            top.fail("pile", concat("\"", *pile, "\""), concat("a saved pile file (", path.string(), " does not exist)"));
+        s.pile = path.string();
+    }
     for (const MapReader& f : top.maps("fills")) s.fills.push_back(read_fill(s, f));
     for (const MapReader& p : top.maps("pours")) {
         PourSpec pour;
@@ -486,8 +493,8 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         pour.velocity_m_per_s = p.vector3("velocity_m_per_s");
         s.pours.push_back(pour);
     }
-    if (s.fills.empty() && s.pours.empty())
-        throw InputError(concat(s.source, ": the scenario has no particles; add a 'fills' or a 'pours' entry"));
+    if (s.fills.empty() && s.pours.empty() && s.pile.empty())
+        throw InputError(concat(s.source, ": the scenario has no particles; add a 'fills', 'pours' or 'pile' entry"));
 
     const MapReader coupling = top.map("coupling");
     const std::int64_t substeps = coupling.integer("substeps");
@@ -564,12 +571,18 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     require_non_negative(s.output.checkpoint_interval_s, "checkpoint_interval_s", out.where("checkpoint_interval_s"));
     s.output.progress_interval_s = out.number("progress_interval_s");
     require_positive(s.output.progress_interval_s, "progress_interval_s", out.where("progress_interval_s"));
+    if (const auto file = out.optional_text("pile_file")) {
+        if (file->empty() || file->find('/') != std::string::npos)
+            out.fail("pile_file", concat("\"", *file, "\""), "a file name (it is written into the output folder)");
+        s.output.pile_file = *file;
+    }
+    s.output.pile_cut_above_m = out.number("pile_cut_above_m");
     return s;
 }
 
 bool Scenario::uses_coupling() const
 {
-    if (shovel || !wear.empty()) return true;
+    if (shovel || !wear.empty() || !pile.empty() || !output.pile_file.empty()) return true;
     for (const FillSpec& f : fills)
         if (!f.rocks.empty()) return true;
     return false;

@@ -96,6 +96,8 @@ struct ReposeProbe {
 
 struct OutputSpec {
     double vtk_interval_s = 0.1, csv_interval_s = 0.01, checkpoint_interval_s = 0.0, progress_interval_s = 10.0;
+    std::string pile_file;      ///< file name in the output folder, or empty
+    double pile_cut_above_m = 1e9;
 };
 
 /// A parsed, checked scenario.
@@ -111,6 +113,7 @@ struct Scenario {
     dem::MaterialTable materials;
     std::vector<PlaneSpec> planes;
     std::vector<MeshSpec> meshes;
+    std::string pile;  ///< a saved pile to start from (absolute path), or empty
     std::vector<FillSpec> fills;
     std::vector<PourSpec> pours;
     std::vector<RegionProbe> regions;
@@ -120,8 +123,8 @@ struct Scenario {
     std::optional<ShovelSpec> shovel;
     std::vector<WearSpec> wear;
 
-    /// True if the run goes through the coupling (scenario/rigid_scene.h): it has rocks, the shovel or
-    /// wear surfaces.
+    /// True if the run goes through the coupling (scenario/rigid_scene.h): it has rocks, the shovel, wear
+    /// surfaces, or starts from or saves a pile.
     bool uses_coupling() const;
 };
 

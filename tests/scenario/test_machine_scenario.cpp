@@ -2,6 +2,7 @@
 // statics (the material held in the dipper weighs on dipper and door with its weight; the mass in the
 // dipper and the fill factor count exactly that material; a pass is recorded when the door opens).
 #include "core/errors.h"
+#include "coupling/mixed_bed.h"
 #include "meshes/machine_geometry.h"
 #include "rigid/convex_polyhedron.h"
 #include "rigid/motion_curves.h"
@@ -364,4 +365,70 @@ fills:
     vz /= static_cast<double>(scene.coupled().rocks().size());
     UNSCOPED_INFO("mean rock vertical velocity " << vz << " m/s");
     CHECK(vz == Approx(0.5).margin(0.1));
+}
+
+TEST_CASE("a pile saved cut at a height and loaded by another scenario holds what lay below the cut",
+          "[scenario][rocks]")
+{
+    const fs::path dir = fs::temp_directory_path() / "dipper_saved_pile";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string walls = R"(planes:
+  - {name: floor, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+  - {name: x0, point_m: [-1, 0, 0], normal: [1, 0, 0],  material: steel}
+  - {name: x1, point_m: [1, 0, 0],  normal: [-1, 0, 0], material: steel}
+  - {name: y0, point_m: [0, -1, 0], normal: [0, 1, 0],  material: steel}
+  - {name: y1, point_m: [0, 1, 0],  normal: [0, -1, 0], material: steel}
+)";
+    {
+        std::ofstream out(dir / "build.yaml");
+        out << "dipper_scenario: 1\nthreads: 1\nseed: 2\ntime: {duration_s: 0.6}\n" << walls
+            << "fills:\n  - {mass_kg: 900, box: {min_m: [-0.95, -0.95, 0.02], max_m: [0.95, 0.95, 1.6]},\n"
+               "     sizes: [{radius_m: 0.08, mass_fraction: 0.6}], rocks: [{size_m: 0.3, mass_fraction: 0.4}]}\n"
+               "output: {vtk_interval_s: 0, pile_file: pile.txt, pile_cut_above_m: 0.3}\n";
+        std::ofstream reuse(dir / "reuse.yaml");
+        reuse << "dipper_scenario: 1\nthreads: 1\ntime: {duration_s: 0.01}\n" << walls
+              << "pile: build_out/pile.txt\noutput: {vtk_interval_s: 0}\n";
+    }
+    RunOptions o;
+    o.progress = false;
+    const std::string built = (dir / "build_out").string();
+    REQUIRE(run_scenario(load_scenario((dir / "build.yaml").string()), built, o).status == RunStatus::completed);
+    // what the saved file holds, counted from its own lines: spheres and rocks below 0.3 m only
+    std::ifstream pile(built + "/pile.txt");
+    std::string word;
+    std::size_t spheres = 0, rocks = 0;
+    double z_max = -1.0;
+    pile >> word >> word >> word >> spheres;  // magic, version, "spheres", count
+    for (std::size_t k = 0; k < spheres; ++k) {
+        double x, y, z;
+        pile >> x >> y >> z;
+        z_max = std::max(z_max, z);
+        std::getline(pile, word);
+    }
+    pile >> word >> rocks;
+    CHECK(word == "rocks");
+    CHECK(spheres > 10);
+    CHECK(rocks > 0);
+    CHECK(z_max <= 0.3);
+    UNSCOPED_INFO("saved pile: " << spheres << " spheres, " << rocks << " rocks");
+
+    const Scenario reuse = load_scenario((dir / "reuse.yaml").string());
+    auto dem = build_world(reuse);
+    RigidScene scene(reuse, *dem);
+    coupling::load_state(scene.coupled(), reuse.pile);
+    CHECK(dem->particles().size() == spheres);
+    CHECK(scene.coupled().rocks().size() == rocks);
+    for (const coupling::RockRecord& r : scene.coupled().rocks()) CHECK(scene.rigid().state(r.body).position_m.z <= 0.3);
+    // and the run from it goes
+    CHECK(run_scenario(reuse, (dir / "reuse_out").string(), o).status == RunStatus::completed);
+
+    std::string e;
+    try {
+        parse_scenario(concat("dipper_scenario: 1\ntime: {duration_s: 1}\n", walls, "pile: nowhere.txt\n"), "case.yaml", dir.string());
+    } catch (const InputError& error) {
+        e = error.what();
+    }
+    CHECK_THAT(e, Catch::Contains("pile: got \"nowhere.txt\"; expected a saved pile file"));
+    fs::remove_all(dir);
 }
