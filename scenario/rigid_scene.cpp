@@ -12,23 +12,6 @@ namespace dipper::scenario {
 
 namespace {
 
-/// The default cycle with each pass's dig (its first 15 s) done `factor` times faster; what follows the
-/// dig keeps its duration, so a pass lasts 31 s + 15 s / factor.
-rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor)
-{
-    if (factor == 1.0) return cycle;
-    constexpr double pass = 46.0, dig = 15.0;
-    const double new_pass = pass - dig + dig / factor;
-    std::vector<rigid::MotionSample> samples = cycle.samples();
-    for (rigid::MotionSample& s : samples) {
-        const double k = std::floor(s.time_s / pass + 1e-9);
-        const double local = s.time_s - k * pass;
-        s.time_s = k * new_pass + (local <= dig ? local / factor : local - dig + dig / factor);
-    }
-    return rigid::MotionCurves::from_samples(std::move(samples),
-                                             concat("default three-pass loading cycle, dig ", factor, " times as fast"));
-}
-
 /// A large square of two triangles in a plane, for Bullet (which has a ground plane only for z = const).
 meshes::TriangleMesh plane_patch(const Vec3& point, const Vec3& normal, double half_size_m)
 {
@@ -49,6 +32,21 @@ int rigid_material_or_none(const rigid::RigidWorld& w, const std::string& name)
 }
 
 }  // namespace
+
+rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor)
+{
+    if (factor == 1.0) return cycle;
+    constexpr double pass = 46.0, dig = 15.0;
+    const double new_pass = pass - dig + dig / factor;
+    std::vector<rigid::MotionSample> samples = cycle.samples();
+    for (rigid::MotionSample& s : samples) {
+        const double k = std::floor(s.time_s / pass + 1e-9);
+        const double local = s.time_s - k * pass;
+        s.time_s = k * new_pass + (local <= dig ? local / factor : local - dig + dig / factor);
+    }
+    return rigid::MotionCurves::from_samples(std::move(samples),
+                                             concat("default three-pass loading cycle, dig ", factor, " times as fast"));
+}
 
 RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
 {
@@ -125,6 +123,17 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
             motion = rigid::MotionCurves::from_samples(std::move(samples), concat(motion.source(), ", from t = ", sh.start_s, " s"));
         }
         bulk_density_ = sh.bulk_density_kg_per_m3;
+        // a sphere around each part's steel, in its own frame, so that the tunnelling check skips far rocks
+        for (int part = 0; part < 2; ++part) {
+            std::vector<Vec3> corners;
+            for (const meshes::Plate& plate : part == 0 ? dipper_.body.plates : dipper_.door.plates)
+                for (const Vec3& c : plate.solid_corners_m()) corners.push_back(c);
+            Vec3 centre;
+            for (const Vec3& c : corners) centre += c * (1.0 / static_cast<double>(corners.size()));
+            double radius = 0.0;
+            for (const Vec3& c : corners) radius = std::max(radius, norm(c - centre));
+            part_bounds_[static_cast<std::size_t>(part)] = {centre, radius};
+        }
         motion_ = std::make_unique<rigid::MotionCurves>(motion);
         const rigid::RigidWorld::ShovelParts parts =
             rigid_->add_rope_shovel(dipper_, geometry, std::move(motion), rigid_->material_index("bucket"), sh.position_m, sh.heading_deg);
@@ -227,10 +236,12 @@ void RigidScene::check_tunnelling() const
         else rigid_->door_pose(r, o);
         const Mat3 back = r.transposed();
         const std::vector<meshes::Plate>& plates = part == 0 ? dipper_.body.plates : dipper_.door.plates;
+        const Sphere& bound = part_bounds_[static_cast<std::size_t>(part)];
         for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
             const rigid::BodyId id = coupled_->rocks()[k].body;
             const Vec3 c = rigid_->state(id).position_m;
             const Vec3 q = back * (c - o);
+            if (norm_squared(q - bound.centre) > bound.radius * bound.radius) continue;  // far from every plate
             for (std::size_t p = 0; p < plates.size(); ++p)
                 if (inside_plate(plates[p], q)) {
                     const double dt = coupled_->dem_step_s();

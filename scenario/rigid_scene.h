@@ -9,6 +9,7 @@
 #include "scenario/scenario.h"
 #include "wear/wear_surface.h"
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -44,6 +45,11 @@ struct SceneWear {
     int wall = -1;              ///< DEM wall whose sphere contacts it sums
     rigid::BodyId body = -1;    ///< Bullet body whose rock contacts it sums (-1: none)
 };
+
+/// The default three-pass cycle (rigid::default_loading_cycle, passes of 46 s that start with a 15 s dig)
+/// with each dig done `factor` times faster; what follows a dig keeps its duration, so a pass lasts
+/// 31 s + 15 s / factor. The positions the curves pass through do not change.
+rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor);
 
 class RigidScene {
 public:
@@ -107,6 +113,11 @@ private:
     std::unique_ptr<rigid::RigidWorld> rigid_;
     std::unique_ptr<coupling::CoupledWorld> coupled_;
     meshes::Dipper dipper_;
+    struct Sphere {
+        Vec3 centre;
+        double radius = 0.0;
+    };
+    std::array<Sphere, 2> part_bounds_{};  ///< around the dipper's and the door's plates, in their frames
     std::unique_ptr<rigid::MotionCurves> motion_;  ///< the shovel's curves (the dig phase is read from them)
     double bulk_density_ = 1903.0;
     rigid::BodyId dipper_body_ = -1, door_body_ = -1;

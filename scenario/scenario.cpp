@@ -27,6 +27,13 @@ std::string joined(const std::vector<std::string>& names)
     return s;
 }
 
+/// A file named in the scenario: absolute, or relative to the scenario file's folder.
+std::string resolved(const std::string& base_dir, const std::string& file)
+{
+    const std::filesystem::path p(file);
+    return (p.is_absolute() ? p : std::filesystem::path(base_dir) / p).string();
+}
+
 /// One YAML map of the scenario, read through the key table: every key it holds must be in the table,
 /// every key read must be in the table, and an absent key takes the table's default.
 class MapReader {
@@ -107,6 +114,17 @@ public:
     }
 
     std::string text(const std::string& key) const { return scalar(key, "a text"); }
+    /// A text that must be one of `values`; anything else is an error listing them.
+    std::string one_of(const std::string& key, const std::vector<std::string>& values) const
+    {
+        const std::string v = text(key);
+        for (const std::string& allowed : values)
+            if (v == allowed) return v;
+        std::string list;
+        for (std::size_t k = 0; k < values.size(); ++k)
+            list += (k == 0 ? "" : k + 1 == values.size() ? " or " : ", ") + values[k];
+        fail(key, concat("\"", v, "\""), list);
+    }
     std::optional<std::string> optional_text(const std::string& key) const
     {
         if (!has(key)) return std::nullopt;
@@ -359,19 +377,12 @@ ShovelSpec read_shovel(const Scenario& s, const MapReader& m)
     sh.heading_deg = m.number("heading_deg");
     sh.rake_angle_deg = m.number("rake_angle_deg");
     require_in_range(sh.rake_angle_deg, 40.0, 80.0, "rake_angle_deg", m.where("rake_angle_deg"));
-    sh.wear_bars = m.text("wear_bars");
-    if (sh.wear_bars != "baseline" && sh.wear_bars != "transverse" && sh.wear_bars != "diagonal")
-        m.fail("wear_bars", concat("\"", sh.wear_bars, "\""), "baseline, transverse or diagonal");
+    sh.wear_bars = m.one_of("wear_bars", {"baseline", "transverse", "diagonal"});
     sh.element_size_m = m.number("element_size_m");
     require_in_range(sh.element_size_m, 0.02, 1.0, "element_size_m", m.where("element_size_m"));
     sh.material = material_known(s, m, "material", true);
     sh.motion = m.text("motion");
-    if (sh.motion != "default_cycle") {
-        const std::filesystem::path file = std::filesystem::path(sh.motion).is_absolute()
-                                               ? std::filesystem::path(sh.motion)
-                                               : std::filesystem::path(s.base_dir) / sh.motion;
-        sh.motion = file.string();
-    }
+    if (sh.motion != "default_cycle") sh.motion = resolved(s.base_dir, sh.motion);
     const std::int64_t passes = m.integer("passes");
     if (passes < 0 || passes > 1000) m.fail("passes", concat(passes), "0 (run for time.duration_s) or a number of passes");
     sh.passes = static_cast<int>(passes);
@@ -443,8 +454,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
                    "a mesh file or a generated part, one of the two");
         if (!mesh.part.empty()) {
             mesh.where = m.where("part");
-            if (mesh.part != "truck_body" && mesh.part != "feeder_pan" && mesh.part != "feeder_bin")
-                m.fail("part", concat("\"", mesh.part, "\""), "truck_body, feeder_pan or feeder_bin");
+            (void)m.one_of("part", {"truck_body", "feeder_pan", "feeder_bin"});
         }
         mesh.element_size_m = m.number("element_size_m");
         require_in_range(mesh.element_size_m, 0.02, 2.0, "element_size_m", m.where("element_size_m"));
@@ -478,11 +488,9 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     }
 
     if (const auto pile = top.optional_text("pile")) {
-        const std::filesystem::path path = std::filesystem::path(*pile).is_absolute() ? std::filesystem::path(*pile)
-                                                                                      : std::filesystem::path(s.base_dir) / *pile;
-        if (!std::filesystem::exists(path))
-            top.fail("pile", concat("\"", *pile, "\""), concat("a saved pile file (", path.string(), " does not exist)"));
-        s.pile = path.string();
+        s.pile = resolved(s.base_dir, *pile);
+        if (!std::filesystem::exists(s.pile))
+            top.fail("pile", concat("\"", *pile, "\""), concat("a saved pile file (", s.pile, " does not exist)"));
     }
     for (const MapReader& f : top.maps("fills")) s.fills.push_back(read_fill(s, f));
     for (const MapReader& p : top.maps("pours")) {
@@ -528,9 +536,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         spec.tonnage_t = w.number("tonnage_t");
         require_non_negative(spec.tonnage_t, "tonnage_t", w.where("tonnage_t"));
         if (const auto file = w.optional_text("measured_file")) {
-            const std::filesystem::path path = std::filesystem::path(*file).is_absolute() ? std::filesystem::path(*file)
-                                                                                          : std::filesystem::path(s.base_dir) / *file;
-            spec.measured_file = path.string();
+            spec.measured_file = resolved(s.base_dir, *file);
             try {
                 (void)wear::read_measured_points(spec.measured_file);  // its errors name file, line and column
             } catch (const InputError& e) {
@@ -553,9 +559,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         ReposeProbe p;
         p.where = r.where("min_m");
         read_box(r, p.window.min_m, p.window.max_m, "min_m", "max_m");
-        const std::string along = r.text("along");
-        if (along != "x" && along != "y") r.fail("along", concat("\"", along, "\""), "x or y");
-        p.window.along = along[0];
+        p.window.along = r.one_of("along", {"x", "y"})[0];
         p.window.bin_m = r.number("bin_m");
         require_positive(p.window.bin_m, "bin_m", r.where("bin_m"));
         p.window.validate(r.where("bin_m"));
@@ -623,10 +627,7 @@ std::unique_ptr<dem::World> build_world(const Scenario& s)
                 for (Vec3& v : scaled) v = v * m.scale;
                 mesh = meshes::TriangleMesh(std::move(scaled), mesh.triangles(), source);
             } else {
-                const std::filesystem::path file = std::filesystem::path(m.file).is_absolute()
-                                                       ? std::filesystem::path(m.file)
-                                                       : std::filesystem::path(s.base_dir) / m.file;
-                source = file.string();
+                source = resolved(s.base_dir, m.file);
                 mesh = meshes::load_triangle_mesh(source, m.scale);
             }
         } catch (const InputError& e) {

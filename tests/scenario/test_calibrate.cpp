@@ -2,6 +2,7 @@
 // and one small real run that writes the calibration table.
 #include "core/errors.h"
 #include "scenario/calibrate.h"
+#include "scenario/helpers.h"
 
 #include <catch2/catch.hpp>
 
@@ -68,10 +69,7 @@ TEST_CASE("dipper's repose calibration runs the scenario and writes its table", 
     }
     CHECK(c.runs[0].friction == 0.2);
     CHECK(c.runs[1].friction == 1.2);
-    std::ifstream csv(dir + "/calibration.csv");
-    std::stringstream text;
-    text << csv.rdbuf();
-    CHECK_THAT(text.str(), Catch::StartsWith("run,friction,rolling_friction,repose_angle_deg\n0,0.2,0.05,"));
+    CHECK_THAT(test::read_text_file(dir + "/calibration.csv"), Catch::StartsWith("run,friction,rolling_friction,repose_angle_deg\n0,0.2,0.05,"));
     CHECK(fs::exists(dir + "/run_000/summary.json"));
     CHECK(fs::exists(dir + "/run_001/summary.json"));
 

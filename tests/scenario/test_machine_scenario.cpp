@@ -10,6 +10,7 @@
 #include "scenario/rigid_scene.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/helpers.h"
 #include "scenario/sweep.h"
 
 #include <catch2/catch.hpp>
@@ -38,15 +39,7 @@ fills:
 )", extra);
 }
 
-std::string error_of(const std::string& text)
-{
-    try {
-        parse_scenario(text, "case.yaml", ".");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+std::string error_of(const std::string& text) { return test::scenario_error(text); }
 
 }  // namespace
 
@@ -291,10 +284,7 @@ TEST_CASE("measured wear: compared and calibrated at the end of a run; points of
     o.progress = false;
     const RunResult r = run_scenario(load_scenario(file), dir, o);
     REQUIRE(r.status == RunStatus::completed);
-    std::ifstream in(dir + "/summary.json");
-    std::stringstream text;
-    text << in.rdbuf();
-    const std::string s = text.str();
+    const std::string s = test::read_text_file(dir + "/summary.json");
     const auto number = [&](const std::string& key) {
         std::smatch m;
         REQUIRE(std::regex_search(s, m, std::regex("\"" + key + "\": ([-0-9.eE+]+)")));
@@ -431,4 +421,33 @@ TEST_CASE("a pile saved cut at a height and loaded by another scenario holds wha
     }
     CHECK_THAT(e, Catch::Contains("pile: got \"nowhere.txt\"; expected a saved pile file"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("a faster dig shortens each pass's dig and keeps the poses and the rest of the cycle", "[scenario][shovel]")
+{
+    const rigid::ShovelGeometry g;
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    const rigid::MotionCurves cycle = rigid::default_loading_cycle(g, dipper);
+    const double factor = 1.3;
+    const rigid::MotionCurves fast = dig_speed_scaled(cycle, factor);
+    REQUIRE(fast.samples().size() == cycle.samples().size());
+    const double pass = 31.0 + 15.0 / factor;
+    CHECK(fast.duration_s() == Approx(2.0 * pass + 45.99 - 15.0 + 15.0 / factor).epsilon(1e-12));
+    for (std::size_t k = 0; k < cycle.samples().size(); ++k) {
+        const rigid::MotionSample& a = cycle.samples()[k];
+        const rigid::MotionSample& b = fast.samples()[k];
+        // the same poses, in the same order
+        CHECK(b.hoist_length_m == a.hoist_length_m);
+        CHECK(b.crowd_extension_m == a.crowd_extension_m);
+        CHECK(b.swing_deg == a.swing_deg);
+        CHECK(b.door_deg == a.door_deg);
+        // at new times: inside a dig divided by the factor, after it shifted by what the dig saved
+        const double n = std::floor(a.time_s / 46.0 + 1e-9), local = a.time_s - 46.0 * n;
+        const double expected = n * pass + (local <= 15.0 ? local / factor : local - 15.0 + 15.0 / factor);
+        CHECK(b.time_s == Approx(expected).margin(1e-12));
+    }
+    // the dig of the second pass runs from 46 s to 61 s in the default cycle, from 42.5 s to 54.1 s here
+    const rigid::MotionSample mid_default = cycle.at(46.0 + 7.5), mid_fast = fast.at(pass + 7.5 / factor);
+    CHECK(mid_fast.hoist_length_m == Approx(mid_default.hoist_length_m).epsilon(1e-12));
+    CHECK(dig_speed_scaled(cycle, 1.0).samples().size() == cycle.samples().size());
 }

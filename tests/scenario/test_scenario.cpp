@@ -6,6 +6,7 @@
 #include "scenario/keys.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/helpers.h"
 #include "scenario/sweep.h"
 
 #include <catch2/catch.hpp>
@@ -61,24 +62,9 @@ output:
 )", extra);
 }
 
-/// The InputError message of parsing `text`, or "" if it parsed.
-std::string error_of(const std::string& text)
-{
-    try {
-        parse_scenario(text, "case.yaml", ".");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+std::string error_of(const std::string& text) { return test::scenario_error(text); }
 
-std::string read_file(const std::string& path)
-{
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+std::string read_file(const std::string& path) { return test::read_text_file(path); }
 
 std::string summary_value(const std::string& dir, const std::string& key)
 {
