@@ -213,6 +213,38 @@ for part, w in summary.get("wear", {}).items():
             fig.savefig(os.path.join(folder, f"wear_{part}_measured.png"))
             plt.close(fig)
             figures.append((f"Measured and simulated wear of {part}", f"wear_{part}_measured.png"))
+    sections = w.get("sections", {})
+    if sections:
+        lines += ["", "| section | samples | mean simulated [mm/t] | highest [mm/t] | measured points | their mean [mm/t] | simulated there [mm/t] |",
+                  "| --- | --- | --- | --- | --- | --- | --- |"]
+        for name, sec in sections.items():
+            lines.append(f"| {name} | {sec['samples']} | {g(sec['mean_simulated_mm_per_t'])} | {g(sec['max_simulated_mm_per_t'])} | "
+                         f"{sec['measured_points']} | {g(sec.get('mean_measured_mm_per_t')) if 'mean_measured_mm_per_t' in sec else '–'} | "
+                         f"{g(sec.get('mean_simulated_at_points_mm_per_t')) if 'mean_simulated_at_points_mm_per_t' in sec else '–'} |")
+        if note == "":
+            scale = m["scale"] if m else None
+            fig, axes = plt.subplots(len(sections), 1, figsize=(6.4, 2.3 * len(sections) + 0.6), dpi=110, squeeze=False)
+            for ax, name in zip(axes[:, 0], sections):
+                with open(os.path.join(folder, f"wear_{part}_section_{name}.csv")) as f:
+                    rows = list(csv.DictReader(f))
+                sim = [r for r in rows if r["kind"] == "simulated"]
+                mea = [r for r in rows if r["kind"] == "measured"]
+                s_arc = [float(r["arc_length_m"]) for r in sim]
+                s_rate = [float(r["simulated_mm_per_t"]) for r in sim]
+                ax.plot(s_arc, s_rate, "-", label=f"simulated, constant {g(w['constant'])}")
+                if scale:
+                    ax.plot(s_arc, [x * scale for x in s_rate], "--", label=f"simulated, calibrated {g(m['calibrated_constant'])}")
+                if mea:
+                    ax.plot([float(r["arc_length_m"]) for r in mea], [float(r["measured_mm_per_t"]) for r in mea], "ko", label="measured")
+                ax.set_title(f"section {name}", fontsize=9)
+                ax.set_ylabel("wear rate [mm/t]")
+                ax.grid(True, alpha=0.3)
+            axes[-1, 0].set_xlabel("distance along the section [m]")
+            axes[0, 0].legend(fontsize=7)
+            fig.tight_layout()
+            fig.savefig(os.path.join(folder, f"wear_{part}_sections.png"))
+            plt.close(fig)
+            figures.append((f"Wear rate of {part} along its sections", f"wear_{part}_sections.png"))
     if os.path.exists(os.path.join(folder, f"wear_{part}_map.png")):
         figures.append((f"Wear rate of {part} (mm/t, seen from +z of the part)", f"wear_{part}_map.png"))
 lines.append("")

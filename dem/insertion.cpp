@@ -183,11 +183,13 @@ FillReport fill_lattice(World& world, const Vec3& lo, const Vec3& hi, double rad
 }
 
 Pourer::Pourer(BoxRegion region, SizeDistribution distribution, MaterialIndex material, double mass_flow_kg_per_s,
-               double total_mass_kg, const Vec3& initial_velocity_m_per_s, std::uint64_t seed)
+               double total_mass_kg, const Vec3& initial_velocity_m_per_s, std::uint64_t seed, double start_s)
     : region_(region), material_(material), mass_flow_kg_per_s_(mass_flow_kg_per_s),
-      initial_velocity_(initial_velocity_m_per_s), random_(seed)
+      initial_velocity_(initial_velocity_m_per_s), not_before_s_(start_s), random_(seed)
 {
     require_positive(mass_flow_kg_per_s, "mass_flow_kg_per_s", "Pourer");
+    if (!(start_s >= 0.0) || !std::isfinite(start_s))
+        throw InputError(concat("Pourer: start_s = ", start_s, "; expected a finite time >= 0"));
     if (!is_finite(initial_velocity_m_per_s)) throw InputError("Pourer: initial velocity must be finite");
     require_positive(total_mass_kg, "total_mass_kg", "Pourer");
     distribution.validate("Pourer");
@@ -199,6 +201,7 @@ Pourer::Pourer(BoxRegion region, SizeDistribution distribution, MaterialIndex ma
 std::size_t Pourer::update(World& world)
 {
     if (start_time_s_ < 0.0) {
+        if (world.time_s() < not_before_s_) return 0;
         start_time_s_ = world.time_s();
         const Material& m = world.materials().material(material_);
         if (m.is_surface) throw InputError("Pourer: material is a surface material");

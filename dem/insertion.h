@@ -84,8 +84,9 @@ FillReport fill_lattice(World& world, const Vec3& lo_m, const Vec3& hi_m, double
 class Pourer {
 public:
     Pourer(BoxRegion region, SizeDistribution distribution, MaterialIndex material, double mass_flow_kg_per_s,
-           double total_mass_kg, const Vec3& initial_velocity_m_per_s, std::uint64_t seed);
-    /// Inserts what is due by the world's current time; returns how many particles were added.
+           double total_mass_kg, const Vec3& initial_velocity_m_per_s, std::uint64_t seed, double start_s = 0.0);
+    /// Inserts what is due by the world's current time; returns how many particles were added. Nothing
+    /// enters before `start_s`; the flow counts from the first call at or after it.
     std::size_t update(World& world);
     bool done() const { return start_time_s_ >= 0.0 && next_ >= radii_.size(); }
     double poured_mass_kg() const { return poured_mass_kg_; }
@@ -102,6 +103,7 @@ private:
     double total_mass_kg_ = 0.0;
     std::vector<double> radii_;
     std::size_t next_ = 0;
+    double not_before_s_ = 0.0;
     double poured_mass_kg_ = 0.0, start_time_s_ = -1.0;
     std::mt19937_64 random_;
 };

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -31,6 +32,21 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
                    std::optional<PrescribedMotion> motion)
     : mesh_(std::move(mesh)), material_(material), name_(std::move(name)), motion_(motion)
 {
+    packed_body_.resize(mesh_.triangle_count());
+    const auto& v = mesh_.vertices_m();
+    for (std::size_t t = 0; t < mesh_.triangle_count(); ++t) {
+        const auto& tri = mesh_.triangles()[t];
+        packed_body_[t] = {v[tri[0]], v[tri[1]], v[tri[2]], mesh_.triangle_normal(t)};
+    }
+    if (!v.empty()) {
+        Vec3 lo = v[0], hi = v[0];
+        for (const Vec3& x : v) {
+            lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+            hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+        }
+        bound_centre_ = (lo + hi) * 0.5;
+        for (const Vec3& x : v) bound_radius_m_ = std::max(bound_radius_m_, norm(x - bound_centre_));
+    }
     if (motion_) {
         Mat3 r;
         Vec3 t;
@@ -54,20 +70,36 @@ void MeshWall::set_pose(const Mat3& rotation, const Vec3& translation_m, const V
 {
     ++pose_version_;
     rotation_ = rotation;
+    rotation_transposed_ = rotation.transposed();
     translation_ = translation_m;
     reference_point_ = reference_point_world_m;
     reference_velocity_ = reference_velocity_m_per_s;
     angular_velocity_ = angular_velocity_rad_per_s;
-    const auto& body = mesh_.vertices_m();
-    vertices_world_.resize(body.size());
-    for (std::size_t v = 0; v < body.size(); ++v) vertices_world_[v] = rotation * body[v] + translation_m;
-    normals_world_.resize(mesh_.triangle_count());
-    packed_.resize(mesh_.triangle_count());
-    for (std::size_t t = 0; t < mesh_.triangle_count(); ++t) {
-        normals_world_[t] = rotation * mesh_.triangle_normal(t);
-        const auto& tri = mesh_.triangles()[t];
-        packed_[t] = {vertices_world_[tri[0]], vertices_world_[tri[1]], vertices_world_[tri[2]], normals_world_[t]};
+    vertices_current_ = false;
+}
+
+const std::vector<Vec3>& MeshWall::vertices_world_m() const
+{
+    if (!vertices_current_) {
+        const auto& body = mesh_.vertices_m();
+        vertices_world_.resize(body.size());
+        for (std::size_t v = 0; v < body.size(); ++v) vertices_world_[v] = rotation_ * body[v] + translation_;
+        vertices_current_ = true;
     }
+    return vertices_world_;
+}
+
+double MeshWall::max_vertex_move_m(const Mat3& rotation0, const Vec3& translation0_m) const
+{
+    // for rotations, |R - R0|_2 = |R0^T R - I|_2 = 2 sin(theta / 2) = sqrt(3 - trace(R0^T R))
+    double trace = 0.0;
+    Mat3 d;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            d.m[i][j] = rotation_.m[i][j] - rotation0.m[i][j];
+            trace += rotation_.m[i][j] * rotation0.m[i][j];
+        }
+    return norm(d * bound_centre_ + translation_ - translation0_m) + std::sqrt(std::max(0.0, 3.0 - trace)) * bound_radius_m_;
 }
 
 void MeshWall::restore_pose(const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_world_m,

@@ -37,7 +37,8 @@ struct PrescribedMotion {
     Vec3 pivot_position_m(double t_s) const;
 };
 
-/// A triangle's world vertices and unit normal in one place, for the contact search's inner loop.
+/// A triangle's vertices and unit normal in one place, in its mesh's body frame: the contact search
+/// copies them into each sphere's candidate list and tests the sphere in that frame.
 struct PackedTriangle {
     Vec3 a, b, c, normal;
 };
@@ -59,9 +60,16 @@ public:
     }
 
     const meshes::TriangleMesh& mesh() const { return mesh_; }
-    const std::vector<Vec3>& vertices_world_m() const { return vertices_world_; }
-    const Vec3& normal_world(std::size_t t) const { return normals_world_[t]; }
-    const PackedTriangle& packed(std::size_t t) const { return packed_[t]; }
+    /// The vertices at the current pose, computed on the first call after a pose change (so that a wall
+    /// moved every step costs nothing until someone asks). Not thread-safe: call from one thread.
+    const std::vector<Vec3>& vertices_world_m() const;
+    /// Triangle t in the body frame.
+    const PackedTriangle& packed_body(std::size_t t) const { return packed_body_[t]; }
+    Vec3 to_body(const Vec3& x_world_m) const { return rotation_transposed_ * (x_world_m - translation_); }
+    Vec3 to_world(const Vec3& x_body_m) const { return rotation_ * x_body_m + translation_; }
+    /// An upper bound on how far any vertex has moved from where the pose (rotation0, translation0) put it:
+    /// |(R - R0) c + T - T0| + |R - R0|_2 rho, with c and rho a body-frame bounding sphere.
+    double max_vertex_move_m(const Mat3& rotation0, const Vec3& translation0_m) const;
     const Vec3& angular_velocity_rad_per_s() const { return angular_velocity_; }
     /// The point whose velocity set_pose gave (a rigid body's centre of mass), world frame.
     const Vec3& reference_point_m() const { return reference_point_; }
@@ -87,12 +95,14 @@ private:
     MaterialIndex material_;
     std::string name_;
     std::optional<PrescribedMotion> motion_;
-    Mat3 rotation_;
+    Mat3 rotation_, rotation_transposed_;
     Vec3 translation_;
     Vec3 reference_point_, reference_velocity_, angular_velocity_;
-    std::vector<Vec3> vertices_world_;
-    std::vector<Vec3> normals_world_;
-    std::vector<PackedTriangle> packed_;
+    std::vector<PackedTriangle> packed_body_;
+    Vec3 bound_centre_;        ///< body frame
+    double bound_radius_m_ = 0.0;
+    mutable std::vector<Vec3> vertices_world_;
+    mutable bool vertices_current_ = false;
     std::uint64_t pose_version_ = 0;
     double mass_kg_ = 0.0;
 };

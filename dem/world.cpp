@@ -333,14 +333,12 @@ bool World::needs_rebuild(double particle_move_m) const
 {
     if (2.0 * particle_move_m > skin_m_) return true;
 
-    double mesh_move2 = 0.0;
+    double mesh_move = 0.0;
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
         if (meshes_[m].pose_version() == reference_mesh_version_[m]) continue;  // not moved since the rebuild
-        const auto& now = meshes_[m].vertices_world_m();
-        const auto& then = reference_mesh_vertices_m_[m];
-        for (std::size_t k = 0; k < now.size(); ++k) mesh_move2 = std::max(mesh_move2, norm_squared(now[k] - then[k]));
+        mesh_move = std::max(mesh_move, meshes_[m].max_vertex_move_m(reference_mesh_rotation_[m], reference_mesh_translation_m_[m]));
     }
-    return particle_move_m + std::sqrt(mesh_move2) > skin_m_;
+    return particle_move_m + mesh_move > skin_m_;
 }
 
 void World::finish_step(double dt_s)
@@ -541,10 +539,12 @@ void World::rebuild()
     build_wall_candidates(lo, cell, dims, cell_start);
 
     reference_position_m_ = particles_.position_m;
-    reference_mesh_vertices_m_.resize(meshes_.size());
+    reference_mesh_rotation_.resize(meshes_.size());
+    reference_mesh_translation_m_.resize(meshes_.size());
     reference_mesh_version_.resize(meshes_.size());
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
-        reference_mesh_vertices_m_[m] = meshes_[m].vertices_world_m();
+        reference_mesh_rotation_[m] = meshes_[m].rotation();
+        reference_mesh_translation_m_[m] = meshes_[m].translation_m();
         reference_mesh_version_[m] = meshes_[m].pose_version();
     }
 }
@@ -554,6 +554,7 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     const std::size_t n = particles_.size();
     candidate_start_.assign(n + 1, 0);
     candidates_.clear();
+    candidate_triangles_.clear();
     if (walls_.empty() || n == 0) return;
     double r_max = 0.0;
     for (double r : particles_.radius_m) r_max = std::max(r_max, r);
@@ -615,12 +616,18 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
                     out.push_back({static_cast<std::uint32_t>(q), kPlaneCandidate});
                     ++counts[i];
                 }
+            std::uint32_t body_mesh = kPlaneCandidate;
+            Vec3 pb;
             for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1]; ++k) {
                 const MeshCandidate mc = bucket[k];
-                const PackedTriangle& pt = meshes_[mc.mesh].packed(mc.triangle);
-                const double plane_distance = dot(p - pt.a, pt.normal);
+                if (mc.mesh != body_mesh) {
+                    body_mesh = mc.mesh;
+                    pb = meshes_[mc.mesh].to_body(p);
+                }
+                const PackedTriangle& pt = meshes_[mc.mesh].packed_body(mc.triangle);
+                const double plane_distance = dot(pb - pt.a, pt.normal);
                 if (plane_distance >= range || plane_distance <= -range) continue;
-                if (meshes::closest_point_on_triangle(p, pt.a, pt.b, pt.c).distance_squared < range * range) {
+                if (meshes::closest_point_on_triangle(pb, pt.a, pt.b, pt.c).distance_squared < range * range) {
                     out.push_back(mc);
                     ++counts[i];
                 }
@@ -629,6 +636,16 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     }
     for (std::size_t i = 0; i < n; ++i) candidate_start_[i + 1] = candidate_start_[i] + counts[i];
     for (const auto& v : per_thread) candidates_.insert(candidates_.end(), v.begin(), v.end());
+    copy_candidate_triangles();
+}
+
+void World::copy_candidate_triangles()
+{
+    // each candidate's triangle beside it: the search streams through them instead of visiting the meshes
+    candidate_triangles_.resize(candidates_.size());
+    for (std::size_t k = 0; k < candidates_.size(); ++k)
+        if (candidates_[k].triangle != kPlaneCandidate)
+            candidate_triangles_[k] = meshes_[candidates_[k].mesh].packed_body(candidates_[k].triangle);
 }
 
 // ---- forces --------------------------------------------------------------------------------------
@@ -739,26 +756,30 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
 
     // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
     const int first_mesh_hit = static_cast<int>(hits.size());
+    // each mesh's triangles are tested in its body frame, with the sphere's centre moved there once per mesh
+    std::uint32_t body_mesh = kPlaneCandidate;
+    Vec3 xb;
     for (; k < last; ++k) {
         const MeshCandidate mc = candidates_[k];
         const MeshWall& mw = meshes_[mc.mesh];
-        const PackedTriangle& pt = mw.packed(mc.triangle);
-        if (k + 2 < last) {  // the triangles are scattered over many meshes: ask for the one after next early
-            const MeshCandidate ahead = candidates_[k + 2];
-            __builtin_prefetch(&meshes_[ahead.mesh].packed(ahead.triangle));
+        if (mc.mesh != body_mesh) {
+            body_mesh = mc.mesh;
+            xb = mw.to_body(x);
         }
+        const PackedTriangle& pt = candidate_triangles_[k];
         // a triangle whose plane is r or more away cannot be touched: one dot product spares the closest point
-        const double plane_distance = dot(x - pt.a, pt.normal);
+        const double plane_distance = dot(xb - pt.a, pt.normal);
         if (plane_distance >= r || plane_distance <= -r) continue;
-        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(x, pt.a, pt.b, pt.c);
+        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
         if (cp.distance_squared >= r * r) continue;
         const auto& tri = mw.mesh().triangles()[mc.triangle];
         const double dist = std::sqrt(cp.distance_squared);
-        Vec3 normal = dist > 1e-12 * r ? (x - cp.point) * (1.0 / dist) : pt.normal;
+        const Vec3 point = mw.to_world(cp.point);
+        Vec3 normal = mw.rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : pt.normal);
         std::uint32_t feature_id = mc.triangle;
         if (cp.feature == meshes::Feature::Edge) feature_id = mw.mesh().triangle_edges(mc.triangle)[static_cast<std::size_t>(cp.local_index)];
         if (cp.feature == meshes::Feature::Vertex) feature_id = tri[static_cast<std::size_t>(cp.local_index)];
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, cp.point, normal, r - dist, true});
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, point, normal, r - dist, true});
     }
 
     // One contact per touched feature. A face hit always counts. An edge or vertex hit counts only if no
@@ -1043,8 +1064,8 @@ void World::write_state(StateWriter& out) const
     out.array(pair_touching_);
     out.array(reference_position_m_);
     out.array(stiffness_radius_N_per_m_);
-    out.value<std::uint64_t>(reference_mesh_vertices_m_.size());
-    for (const auto& v : reference_mesh_vertices_m_) out.array(v);
+    out.array(reference_mesh_rotation_);
+    out.array(reference_mesh_translation_m_);
     out.array(reference_mesh_version_);
     out.value(skin_m_);
     out.tag("wall-contacts");
@@ -1102,11 +1123,10 @@ void World::read_state(StateReader& in)
     in.array(pair_touching_);
     in.array(reference_position_m_);
     in.array(stiffness_radius_N_per_m_);
-    const auto reference_meshes = in.value<std::uint64_t>();
-    if (reference_meshes > meshes_.size()) in.fail("more mesh references than meshes");
-    reference_mesh_vertices_m_.resize(static_cast<std::size_t>(reference_meshes));
-    for (auto& v : reference_mesh_vertices_m_) in.array(v);
+    in.array(reference_mesh_rotation_);
+    in.array(reference_mesh_translation_m_);
     in.array(reference_mesh_version_);
+    if (reference_mesh_rotation_.size() > meshes_.size()) in.fail("more mesh references than meshes");
     skin_m_ = in.value<double>();
     in.tag("wall-contacts");
     in.array(wall_contacts_);
@@ -1135,7 +1155,10 @@ void World::read_state(StateReader& in)
         if (c.triangle == kPlaneCandidate ? c.mesh >= planes_.size() : (c.mesh >= meshes_.size() || c.triangle >= meshes_[c.mesh].mesh().triangle_count()))
             in.fail("a wall candidate out of range");
     }
-    if (reference_mesh_version_.size() != reference_mesh_vertices_m_.size()) in.fail("mesh reference arrays differ in length");
+    if (reference_mesh_version_.size() != reference_mesh_rotation_.size() ||
+        reference_mesh_translation_m_.size() != reference_mesh_rotation_.size())
+        in.fail("mesh reference arrays differ in length");
+    copy_candidate_triangles();
     if (wall_force_N_.size() != walls_.size() || wall_torque_N_m_.size() != walls_.size())
         wall_force_N_.assign(walls_.size(), Vec3{}), wall_torque_N_m_.assign(walls_.size(), Vec3{});
     records_.clear();

@@ -164,6 +164,7 @@ private:
     bool needs_rebuild(double particle_move_m) const;
     void rebuild();
     void build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
+    void copy_candidate_triangles();
     void evaluate_forces(double dt_s, double half_kick_s);
     void compute_pair_forces(double dt_s);
     void compute_wall_contacts(double dt_s);
@@ -198,7 +199,8 @@ private:
     std::vector<std::vector<Vec3>> thread_force_N_, thread_torque_N_m_;
     std::vector<Vec3> reference_position_m_;
     std::vector<double> stiffness_radius_N_per_m_;  ///< k r per particle (eq. 4), refreshed at each rebuild
-    std::vector<std::vector<Vec3>> reference_mesh_vertices_m_;
+    std::vector<Mat3> reference_mesh_rotation_;     ///< each mesh's pose at the last rebuild
+    std::vector<Vec3> reference_mesh_translation_m_;
     std::vector<std::uint64_t> reference_mesh_version_;
     double skin_m_ = 0.0;
 
@@ -207,6 +209,7 @@ private:
     std::vector<std::uint32_t> wall_contact_start_;
     std::vector<std::uint32_t> candidate_start_;
     std::vector<MeshCandidate> candidates_;
+    std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside candidates_ (planes: unused)
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;

@@ -19,6 +19,8 @@ const std::vector<std::string>& columns()
     static const std::vector<std::string> c{"time_s", "hoist_length_m", "crowd_extension_m", "swing_deg", "door_deg"};
     return c;
 }
+const char* const kOptional = "propel_m";
+const char* const kExpected = "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg and optionally propel_m";
 
 }  // namespace
 
@@ -28,7 +30,7 @@ MotionCurves MotionCurves::from_samples(std::vector<MotionSample> samples, const
     for (std::size_t k = 0; k < samples.size(); ++k) {
         const MotionSample& s = samples[k];
         const std::string where = concat(source, ", sample ", k);
-        for (const double v : {s.time_s, s.hoist_length_m, s.crowd_extension_m, s.swing_deg, s.door_deg})
+        for (const double v : {s.time_s, s.hoist_length_m, s.crowd_extension_m, s.swing_deg, s.door_deg, s.propel_m})
             if (!std::isfinite(v)) throw InputError(concat(where, ": a value is not finite"));
         if (k > 0 && !(s.time_s > samples[k - 1].time_s))
             throw InputError(concat(where, ": time_s ", s.time_s, " does not follow ", samples[k - 1].time_s,
@@ -59,21 +61,21 @@ MotionCurves MotionCurves::from_csv(const std::string& path)
         const std::string where = concat(path, ":", number);
         if (column.empty()) {
             for (std::size_t c = 0; c < cells.size(); ++c) {
-                if (std::find(columns().begin(), columns().end(), cells[c]) == columns().end())
-                    throw InputError(concat(where, ": unknown column '", cells[c],
-                                            "'; expected time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg"));
+                if (std::find(columns().begin(), columns().end(), cells[c]) == columns().end() && cells[c] != kOptional)
+                    throw InputError(concat(where, ": unknown column '", cells[c], "'; expected ", kExpected));
+                if (column.count(cells[c])) throw InputError(concat(where, ": column '", cells[c], "' appears twice"));
                 column[cells[c]] = c;
             }
             for (const auto& name : columns())
                 if (!column.count(name))
-                    throw InputError(concat(where, ": the header lacks column '", name,
-                                            "'; expected time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg"));
+                    throw InputError(concat(where, ": the header lacks column '", name, "'; expected ", kExpected));
             continue;
         }
         if (cells.size() != column.size())
             throw InputError(concat(where, ": ", cells.size(), " values; the header has ", column.size(), " columns"));
         const auto value = [&](const std::string& name) { return parse_csv_number(cells[column[name]], where, name); };
-        MotionSample s{value("time_s"), value("hoist_length_m"), value("crowd_extension_m"), value("swing_deg"), value("door_deg")};
+        MotionSample s{value("time_s"), value("hoist_length_m"), value("crowd_extension_m"), value("swing_deg"), value("door_deg"),
+                       column.count(kOptional) ? value(kOptional) : 0.0};
         if (!(s.time_s > last_time))
             throw InputError(concat(where, ": time_s ", s.time_s, " is not after the previous time ", last_time,
                                     "; times must increase"));
@@ -98,15 +100,16 @@ MotionSample MotionCurves::at(double t) const
     const double u = (t - a.time_s) / (b.time_s - a.time_s);
     const auto mix = [u](double x, double y) { return x + (y - x) * u; };
     return {t, mix(a.hoist_length_m, b.hoist_length_m), mix(a.crowd_extension_m, b.crowd_extension_m),
-            mix(a.swing_deg, b.swing_deg), mix(a.door_deg, b.door_deg)};
+            mix(a.swing_deg, b.swing_deg), mix(a.door_deg, b.door_deg), mix(a.propel_m, b.propel_m)};
 }
 
 void MotionCurves::write_csv(const std::string& path) const
 {
     std::ofstream out = open_for_writing(path);
-    out << "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg\n";
+    out << "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg,propel_m\n";
     for (const MotionSample& s : samples_)
-        out << s.time_s << ',' << s.hoist_length_m << ',' << s.crowd_extension_m << ',' << s.swing_deg << ',' << s.door_deg << '\n';
+        out << s.time_s << ',' << s.hoist_length_m << ',' << s.crowd_extension_m << ',' << s.swing_deg << ',' << s.door_deg << ','
+            << s.propel_m << '\n';
     finish_writing(out, path);
 }
 

@@ -116,6 +116,16 @@ BodyId RigidWorld::add_ground_plane(double height_m, int material, const std::st
     return impl_->insert(std::move(b), 0.0, btVector3(0, 0, 0), btTransform::getIdentity());
 }
 
+void RigidWorld::set_blocks_machine(BodyId body, bool blocks)
+{
+    Impl::Body& b = impl_->body(body, "set_blocks_machine");
+    if (!b.body || !(b.body->isStaticObject() || b.body->isKinematicObject()))
+        throw InputError(concat("set_blocks_machine: body '", b.name, "' is not fixed or kinematic"));
+    btBroadphaseProxy* proxy = b.body->getBroadphaseHandle();
+    if (blocks) proxy->m_collisionFilterMask |= Impl::kMachineFilter;
+    else proxy->m_collisionFilterMask &= ~Impl::kMachineFilter;
+}
+
 BodyId RigidWorld::add_static_mesh(const meshes::TriangleMesh& mesh, int material, const std::string& name,
                                    const Mat3& rotation, const Vec3& translation_m)
 {

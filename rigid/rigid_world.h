@@ -75,6 +75,10 @@ public:
     BodyId add_plates(const std::vector<meshes::Plate>& plates, int material, const std::string& name, bool kinematic,
                       const Mat3& rotation = Mat3::identity(), const Vec3& translation_m = {});
     void set_kinematic_pose(BodyId body, const Mat3& rotation, const Vec3& translation_m);
+    /// Whether the rope shovel's links collide with the fixed or kinematic body `body` (default: they do).
+    /// Call before stepping. Boundaries that only hold material (a slice's side walls, a truck body the
+    /// prescribed motion clears) can let the machine pass instead of stopping its drives.
+    void set_blocks_machine(BodyId body, bool blocks);
     /// A rock: `shape` in its principal frame (ConvexPolyhedron::in_principal_frame, or generate_rock), placed
     /// with its centroid at `position_m`. Mass and inertia come from the shape and density.
     BodyId add_rock(const ConvexPolyhedron& shape, double density_kg_per_m3, int material, const Vec3& position_m,

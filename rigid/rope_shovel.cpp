@@ -104,10 +104,11 @@ ShovelPose pose_shovel(const ShovelGeometry& g, const meshes::Dipper& d, double 
     return p;
 }
 
-MotionCurves default_loading_cycle(const ShovelGeometry& g, const meshes::Dipper& d)
+namespace {
+/// The steepest handle angle up to 75 deg below horizontal at 8.5 m of crowd that keeps the dipper's
+/// lowest point (teeth, lip) 0.1 m above the ground (z = 0): where each dig starts.
+double toe_handle_angle_deg(const ShovelGeometry& g, const meshes::Dipper& d)
 {
-    // the dig starts with the dipper's lowest point (teeth, lip) 0.1 m above the ground (z = 0): the
-    // steepest handle angle up to 75 deg that allows it at 8.5 m of crowd
     const auto lowest = [&](double angle) {
         const ShovelPose p = pose_shovel(g, d, angle, 8.5);
         double z = 1e300;
@@ -117,9 +118,33 @@ MotionCurves default_loading_cycle(const ShovelGeometry& g, const meshes::Dipper
     };
     double toe = 75.0;
     while (toe > 30.0 && lowest(toe) < 0.1) toe -= 0.5;
-    // key poses: (handle angle below horizontal, crowd extension)
-    struct Key { double t, angle, crowd, swing, door; };
-    const Key pass[] = {
+    return toe;
+}
+
+/// A key pose of a cycle: handle angle below horizontal, crowd extension, swing and door, and how much
+/// of this pass's propel (0 to 1) the crawlers have done.
+struct KeyPose { double t, angle, crowd, swing, door, propelled = 0.0; };
+
+MotionCurves repeated(const ShovelGeometry& g, const meshes::Dipper& d, const std::vector<KeyPose>& pass, double period_s,
+                      int count, const std::string& name, double advance_per_pass_m = 0.0)
+{
+    std::vector<MotionSample> samples;
+    for (int k = 0; k < count; ++k)
+        for (const KeyPose& key : pass) {
+            const double t = period_s * k + key.t;
+            samples.push_back({t, pose_shovel(g, d, key.angle, key.crowd).rope_length_m, key.crowd, key.swing, key.door,
+                               advance_per_pass_m * (k + key.propelled)});
+        }
+    return MotionCurves::from_samples(std::move(samples), name);
+}
+}  // namespace
+
+MotionCurves default_loading_cycle(const ShovelGeometry& g, const meshes::Dipper& d, double advance_per_pass_m)
+{
+    if (!(advance_per_pass_m >= 0.0 && advance_per_pass_m <= 10.0))
+        throw InputError(concat("default_loading_cycle: advance_per_pass_m = ", advance_per_pass_m, "; expected 0 to 10 m"));
+    const double toe = toe_handle_angle_deg(g, d);
+    const std::vector<KeyPose> pass = {
         {0.0, toe, 8.5, 0.0, 0.0},      // dig start: dipper at the toe of the bank
         {5.0, 55.0, 8.0, 0.0, 0.0},
         {10.0, 30.0, 7.6, 0.0, 0.0},
@@ -127,17 +152,37 @@ MotionCurves default_loading_cycle(const ShovelGeometry& g, const meshes::Dipper
         {25.0, 20.0, 6.5, 90.0, 0.0},   // swung to the truck, lowered to the dump pose
         {26.0, 20.0, 6.5, 90.0, 60.0},  // door open
         {28.0, 20.0, 6.5, 90.0, 60.0},
-        {33.0, 45.0, 7.5, 45.0, 0.0},   // swinging back, door shut
-        {40.0, toe, 8.5, 0.0, 0.0},     // back at the toe
-        {45.99, toe, 8.5, 0.0, 0.0},
+        // swinging back high (the lowest point 8 m up), door shut; the crawlers propel from 28 s to 41 s
+        {33.0, 10.0, 6.5, 45.0, 0.0, 5.0 / 13.0},
+        {37.0, 10.0, 6.5, 0.0, 0.0, 9.0 / 13.0},
+        {39.0, 10.0, 4.0, 0.0, 0.0, 11.0 / 13.0}, // crowd drawn in
+        {42.0, 70.0, 5.0, 0.0, 0.0, 1.0},         // lowered, hanging in front of the bank
+        {45.0, toe, 8.5, 0.0, 0.0, 1.0},          // crowded out into the toe
+        {45.99, toe, 8.5, 0.0, 0.0, 1.0},
     };
-    std::vector<MotionSample> samples;
-    for (int k = 0; k < 3; ++k)
-        for (const Key& key : pass) {
-            const double t = 46.0 * k + key.t;
-            samples.push_back({t, pose_shovel(g, d, key.angle, key.crowd).rope_length_m, key.crowd, key.swing, key.door});
-        }
-    return MotionCurves::from_samples(std::move(samples), "default three-pass loading cycle");
+    return repeated(g, d, pass, kDefaultCyclePass_s, 3,
+                    advance_per_pass_m > 0.0 ? concat("default three-pass loading cycle, advancing ", advance_per_pass_m, " m per pass")
+                                             : std::string("default three-pass loading cycle"),
+                    advance_per_pass_m);
+}
+
+MotionCurves dig_and_return_cycle(const ShovelGeometry& g, const meshes::Dipper& d, int cycles)
+{
+    if (cycles < 1 || cycles > 1000) throw InputError(concat("dig_and_return_cycle: cycles = ", cycles, "; expected 1 to 1000"));
+    const double toe = toe_handle_angle_deg(g, d);
+    const std::vector<KeyPose> pass = {
+        {0.0, toe, 8.5, 0.0, 0.0},      // the default cycle's dig
+        {5.0, 55.0, 8.0, 0.0, 0.0},
+        {10.0, 30.0, 7.6, 0.0, 0.0},
+        {15.0, 0.0, 7.5, 0.0, 0.0},
+        {19.0, 20.0, 3.0, 0.0, 0.0},    // crowd drawn in: the heel 8 m above the toe, the door facing down
+        {20.0, 20.0, 3.0, 0.0, 60.0},   // door open: the load falls where the next dig begins
+        {24.0, 20.0, 3.0, 0.0, 60.0},
+        {25.0, 20.0, 3.0, 0.0, 0.0},    // door shut
+        {29.0, toe, 8.5, 0.0, 0.0},     // back at the toe
+        {29.99, toe, 8.5, 0.0, 0.0},
+    };
+    return repeated(g, d, pass, kDigAndReturnPass_s, cycles, concat("dig-and-return cycle of ", cycles, " fillings"));
 }
 
 struct ShovelState {
@@ -158,7 +203,27 @@ struct ShovelState {
     struct Sample { double t, crowd, hoist; };
     std::deque<Sample> window;
     ShovelReading reading;
+    btVector3 base_origin;       // where the machine stands before it propels
+    btVector3 forward;           // unit, its heading on the ground
+    bool propels = false;        // the motion moves the machine (else its base never changes)
+    double step_s = 0.0;
 };
+
+namespace {
+/// Places the machine where the motion's propel puts it at time t, moving at the propel speed, and
+/// updates the links' world transforms.
+void place_base(ShovelState& s, double t, double dt)
+{
+    btMultiBody& mb = *s.body;
+    const double p = s.motion.at(t).propel_m, p_next = s.motion.at(t + dt).propel_m;
+    mb.setBasePos(s.base_origin + s.forward * p);
+    mb.setBaseVel(s.forward * ((p_next - p) / dt));
+    btAlignedObjectArray<btQuaternion> scratch_q;
+    btAlignedObjectArray<btVector3> scratch_m;
+    mb.forwardKinematics(scratch_q, scratch_m);
+    mb.updateCollisionObjectWorldTransforms(scratch_q, scratch_m);
+}
+}  // namespace
 
 void ShovelDeleter::operator()(ShovelState* s) const { delete s; }
 
@@ -234,6 +299,8 @@ RigidWorld::ShovelParts RigidWorld::add_rope_shovel(const meshes::Dipper& dipper
     mb.finalizeMultiDof();
     const btTransform machine(btQuaternion(btVector3(0, 0, 1), heading_deg * kDeg), to_bt(position_m));
     mb.setBaseWorldTransform(machine);
+    s->base_origin = to_bt(position_m);
+    s->forward = btVector3(std::cos(heading_deg * kDeg), std::sin(heading_deg * kDeg), 0.0);
 
     s->sheave_local = to_bt(zero.sheave_m - g.upper_body_centre_m);
     for (int k = 0; k < 2; ++k) s->bail_local[k] = to_bt(zero.bail_m[k] - com2);
@@ -277,7 +344,7 @@ RigidWorld::ShovelParts RigidWorld::add_rope_shovel(const meshes::Dipper& dipper
         b->link_collider->setActivationState(DISABLE_DEACTIVATION);
         if (link < 0) mb.setBaseCollider(b->link_collider.get());
         else mb.getLink(link).m_collider = b->link_collider.get();
-        impl_->world.addCollisionObject(b->link_collider.get(), btBroadphaseProxy::DefaultFilter, btBroadphaseProxy::AllFilter);
+        impl_->world.addCollisionObject(b->link_collider.get(), Impl::kMachineFilter, btBroadphaseProxy::AllFilter);
         impl_->bodies.push_back(std::move(b));
         impl_->contact_force.resize(impl_->bodies.size());
         return id;
@@ -316,10 +383,9 @@ RigidWorld::ShovelParts RigidWorld::add_rope_shovel(const meshes::Dipper& dipper
     mb.setJointPos(1, 0.5 * (lo + hi) * kDeg);
     mb.setJointPos(2, m0.crowd_extension_m);
     mb.setJointPos(3, m0.door_deg * kDeg);
-    btAlignedObjectArray<btQuaternion> scratch_q;
-    btAlignedObjectArray<btVector3> scratch_m;
-    mb.forwardKinematics(scratch_q, scratch_m);
-    mb.updateCollisionObjectWorldTransforms(scratch_q, scratch_m);
+    for (const MotionSample& m : s->motion.samples()) s->propels = s->propels || m.propel_m != 0.0;
+    s->step_s = impl_->settings.step_s;
+    place_base(*s, impl_->time_s, s->step_s);
     for (auto& b : impl_->bodies)
         if (b->multibody) b->previous_pose = b->link_collider->getWorldTransform();
 
@@ -335,6 +401,7 @@ void shovel_before_step(RigidWorld::Impl& w, double t_next)
     ShovelState& s = *w.shovel;
     btMultiBody& mb = *s.body;
     const double dt = w.settings.step_s;
+    if (s.propels) place_base(s, t_next - dt, dt);
     // drives: reach the curves' positions at the end of the step
     const MotionSample target = s.motion.at(t_next);
     s.swing_motor->setPositionTarget(target.swing_deg * kDeg, 1.0);
@@ -420,6 +487,7 @@ void shovel_after_step(RigidWorld::Impl& w)
     r.hoist_force_filtered_N = hoist / n;
     r.dig_force_filtered_N = std::hypot(r.crowd_force_filtered_N, r.hoist_force_filtered_N);
 
+    if (s.propels) place_base(s, w.time_s, dt);  // exactly where the propel curve has the machine now
     read_pose(s);
 }
 
@@ -462,6 +530,7 @@ void read_shovel_state(ShovelState& s, StateReader& in)
     s.window.clear();
     for (std::uint64_t k = 0; k < n; ++k) s.window.push_back(in.value<ShovelState::Sample>());
     s.reading = in.value<ShovelReading>();
+    place_base(s, s.reading.time_s, s.step_s);
 }
 
 const ShovelReading& RigidWorld::shovel_reading() const

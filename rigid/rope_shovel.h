@@ -49,9 +49,21 @@ ShovelPose pose_shovel(const ShovelGeometry& geometry, const meshes::Dipper& dip
 
 /// Three passes shaped like thesis Paper A Fig. 9 for this geometry: each a dig of 15 s (hoist in, handle
 /// from as steep as the ground allows, at most 75 deg below horizontal, to level), swing 90 deg to the truck while raising to the dump pose, 3 s
-/// dump with the door opening 60 deg, swing back while closing the door and lowering, a short wait:
-/// 46 s per pass, 138 s in all.
-MotionCurves default_loading_cycle(const ShovelGeometry& geometry, const meshes::Dipper& dipper);
+/// dump with the door opening 60 deg, swing back high (the dipper's lowest point 8 m up) while closing
+/// the door, crowd drawn in and the dipper lowered to hang in front of the bank, crowd out into the toe:
+/// 46 s per pass, 138 s in all. With `advance_per_pass_m` > 0 the crawlers carry the machine that far forward while it swings
+/// back after each dump (28 s to 41 s of the pass), so that the next dig reaches the bank the last one
+/// cut back.
+MotionCurves default_loading_cycle(const ShovelGeometry& geometry, const meshes::Dipper& dipper, double advance_per_pass_m = 0.0);
+
+/// Repeated bucket fillings for wear (thesis Paper B §3.5: the bucket is emptied back into the pile it
+/// dug, so the pile keeps its material): `cycles` of 30 s, each the default cycle's 15 s dig, then with no
+/// swing the crowd drawn in to 3 m (handle 20 deg down: the heel 8 m above the toe, the door facing
+/// down), the door opened 60 deg for 4 s so that the load falls where the next dig begins, shut, and the
+/// dipper back at the toe.
+MotionCurves dig_and_return_cycle(const ShovelGeometry& geometry, const meshes::Dipper& dipper, int cycles);
+/// The length of one pass of the two built-in cycles, and of its dig.
+inline constexpr double kDefaultCyclePass_s = 46.0, kDigAndReturnPass_s = 30.0, kBuiltInDig_s = 15.0;
 
 /// What the shovel reports each step.
 struct ShovelReading {

@@ -77,11 +77,12 @@ const std::vector<KeySpec>& scenario_keys()
         {"fills[].rocks[].mass_fraction", "number", "required", "fraction of the fill's mass"},
         {"fills[].rock_elongation_max", "number", "2", "largest length-to-width ratio of the random rock shapes (1 to 4)"},
 
-        {"pours", "list", "[]", "particles entering from a box at a mass flow rate, from t = 0"},
+        {"pours", "list", "[]", "particles entering from a box at a mass flow rate"},
         {"pours[].material", "string", "ore", "particle material"},
         {"pours[].mass_kg", "number", "required", "total mass to pour"},
         {"pours[].rate_kg_per_s", "number", "required", "mass flow rate"},
         {"pours[].velocity_m_per_s", "vector3", "[0, 0, 0]", "velocity of entering particles"},
+        {"pours[].start_s", "number", "0", "time the pour begins (one loader bucket after another)"},
         {"pours[].box", "map", "required", "where particles enter"},
         {"pours[].box.min_m", "vector3", "required", "lower corner"},
         {"pours[].box.max_m", "vector3", "required", "upper corner"},
@@ -100,11 +101,14 @@ const std::vector<KeySpec>& scenario_keys()
         {"shovel.element_size_m", "number", "0.15", "largest surface element of dipper and door (contacts and wear maps)"},
         {"shovel.material", "string", "bucket", "surface material of dipper and door (spheres); rocks see the rigid 'bucket' material"},
         {"shovel.motion", "string", "default_cycle",
-         "default_cycle (three passes of 46 s: dig 15 s, swing, dump, return) or a CSV file of time_s, hoist_length_m, "
-         "crowd_extension_m, swing_deg, door_deg"},
+         "default_cycle (three passes of 46 s: dig 15 s, swing, dump, return), dig_and_return (fillings of 30 s emptied "
+         "over the toe, no swing; as many as shovel.passes, else 3) or a CSV file of time_s, hoist_length_m, "
+         "crowd_extension_m, swing_deg, door_deg and optionally propel_m"},
         {"shovel.start_s", "number", "0", "the motion starts at this time; before it the shovel holds its first pose (a pile settles)"},
         {"shovel.passes", "integer", "0", "the run ends 1 s after the door of this pass opened; 0: it runs for time.duration_s"},
-        {"shovel.dig_speed_factor", "number", "1", "the default cycle's dig done this many times faster (0.5 to 2)"},
+        {"shovel.advance_per_pass_m", "number", "0",
+         "default cycle: the crawlers carry the machine this far forward (along heading_deg) while it swings back after each dump"},
+        {"shovel.dig_speed_factor", "number", "1", "the built-in cycle's dig done this many times faster (0.5 to 2)"},
         {"shovel.bulk_density_kg_per_m3", "number", "1903", "bulk density for the fill factor: mass in the dipper / (bulk density x struck volume)"},
 
         {"wear", "list", "[]", "wear surfaces: contact work on a machine part summed into wear (docs/wear.md)"},
@@ -116,6 +120,11 @@ const std::vector<KeySpec>& scenario_keys()
         {"wear[].tonnage_t", "number", "0", "material that passed over the part in the run, for mm/t; 0 takes the shovel's passes"},
         {"wear[].measured_file", "string", "none",
          "measured wear: CSV of id, x_m, y_m, z_m (part frame), depth_mm, tonnage_t; the run compares and calibrates against it"},
+        {"wear[].sections", "list", "[]",
+         "lines across the part along which the wear rate is written, with the measured points within 0.1 m (thesis Paper B Fig. 16)"},
+        {"wear[].sections[].name", "string", "required", "names the file wear_<part>_section_<name>.csv"},
+        {"wear[].sections[].points_m", "list", "required", "the line: at least two points [x, y, z] in the part's own frame, on its surface"},
+        {"wear[].sections[].spacing_m", "number", "0.05", "distance between the samples along the line"},
 
         {"probes", "map", "{}", "quantities written to probes.csv besides the standard columns"},
         {"probes.regions", "list", "[]", "boxes whose particle mass is recorded (particles by centre)"},

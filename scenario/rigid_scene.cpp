@@ -33,19 +33,18 @@ int rigid_material_or_none(const rigid::RigidWorld& w, const std::string& name)
 
 }  // namespace
 
-rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor)
+rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor, double pass_s)
 {
     if (factor == 1.0) return cycle;
-    constexpr double pass = 46.0, dig = 15.0;
-    const double new_pass = pass - dig + dig / factor;
+    const double dig = rigid::kBuiltInDig_s;
+    const double new_pass = pass_s - dig + dig / factor;
     std::vector<rigid::MotionSample> samples = cycle.samples();
     for (rigid::MotionSample& s : samples) {
-        const double k = std::floor(s.time_s / pass + 1e-9);
-        const double local = s.time_s - k * pass;
+        const double k = std::floor(s.time_s / pass_s + 1e-9);
+        const double local = s.time_s - k * pass_s;
         s.time_s = k * new_pass + (local <= dig ? local / factor : local - dig + dig / factor);
     }
-    return rigid::MotionCurves::from_samples(std::move(samples),
-                                             concat("default three-pass loading cycle, dig ", factor, " times as fast"));
+    return rigid::MotionCurves::from_samples(std::move(samples), concat(cycle.source(), ", dig ", factor, " times as fast"));
 }
 
 RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
@@ -78,8 +77,10 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
     for (const PlaneSpec& p : s.planes) {
         const int m = rigid_material(p.name, p.material);
         if (m < 0) continue;
-        if (p.normal.z > 1.0 - 1e-12) rigid_->add_ground_plane(p.point_m.z, m, p.name);
-        else rigid_->add_static_mesh(plane_patch(p.point_m, p.normal, 500.0), m, p.name);
+        // the scenario's walls hold material; the machine follows its prescribed motion through them
+        rigid_->set_blocks_machine(p.normal.z > 1.0 - 1e-12 ? rigid_->add_ground_plane(p.point_m.z, m, p.name)
+                                                             : rigid_->add_static_mesh(plane_patch(p.point_m, p.normal, 500.0), m, p.name),
+                                   false);
     }
     for (std::size_t k = 0; k < s.meshes.size(); ++k) {
         const MeshSpec& spec = s.meshes[k];
@@ -93,11 +94,13 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
             Vec3 t;
             spec.motion->pose(0.0, r, t);
             const rigid::BodyId body = rigid_->add_kinematic_mesh(mesh.mesh(), m, spec.name, r, t);
+            rigid_->set_blocks_machine(body, false);
             moving_meshes_.push_back({body, *spec.motion});
             static_meshes_.emplace_back(spec.name, body);
             continue;
         }
         static_meshes_.emplace_back(spec.name, rigid_->add_static_mesh(mesh.mesh(), m, spec.name));
+        rigid_->set_blocks_machine(static_meshes_.back().second, false);
     }
 
     if (s.shovel) {
@@ -114,15 +117,25 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
             throw InputError(concat(sh.where, ": ", e.what()));
         }
         const rigid::ShovelGeometry geometry;
-        rigid::MotionCurves motion = sh.motion == "default_cycle"
-                                         ? dig_speed_scaled(rigid::default_loading_cycle(geometry, dipper_), sh.dig_speed_factor)
-                                         : rigid::MotionCurves::from_csv(sh.motion);
+        rigid::MotionCurves motion =
+            sh.motion == "default_cycle"
+                ? dig_speed_scaled(rigid::default_loading_cycle(geometry, dipper_, sh.advance_per_pass_m), sh.dig_speed_factor)
+            : sh.motion == "dig_and_return"
+                ? dig_speed_scaled(rigid::dig_and_return_cycle(geometry, dipper_, sh.passes > 0 ? sh.passes : 3), sh.dig_speed_factor,
+                                   rigid::kDigAndReturnPass_s)
+                : rigid::MotionCurves::from_csv(sh.motion);
         if (sh.start_s > 0.0) {
             std::vector<rigid::MotionSample> samples = motion.samples();
             for (rigid::MotionSample& m : samples) m.time_s += sh.start_s;
             motion = rigid::MotionCurves::from_samples(std::move(samples), concat(motion.source(), ", from t = ", sh.start_s, " s"));
         }
         bulk_density_ = sh.bulk_density_kg_per_m3;
+        if (sh.motion == "default_cycle" || sh.motion == "dig_and_return") {
+            cycle_start_s_ = sh.start_s;
+            cycle_dig_s_ = rigid::kBuiltInDig_s / sh.dig_speed_factor;
+            cycle_period_s_ = (sh.motion == "default_cycle" ? rigid::kDefaultCyclePass_s : rigid::kDigAndReturnPass_s) -
+                              rigid::kBuiltInDig_s + cycle_dig_s_;
+        }
         // a sphere around each part's steel, in its own frame, so that the tunnelling check skips far rocks
         for (int part = 0; part < 2; ++part) {
             std::vector<Vec3> corners;
@@ -198,6 +211,19 @@ void RigidScene::add_wear(const Scenario& s)
                     throw InputError(concat(p.source, ": measured point '", p.id, "' at (", p.position_m.x, ", ", p.position_m.y, ", ",
                                             p.position_m.z, ") m is ", d, " m from the surface of '", spec.part,
                                             "' (in the part's own frame); expected within ", kMeasuredPointTolerance_m, " m"));
+            }
+        for (const WearSectionSpec& section : spec.sections)
+            for (std::size_t k = 0; k + 1 < section.points_m.size(); ++k) {
+                const Vec3 a = section.points_m[k], b = section.points_m[k + 1];
+                const int pieces = std::max(1, static_cast<int>(std::ceil(norm(b - a) / section.spacing_m - 1e-9)));
+                for (int i = 0; i <= pieces; ++i) {
+                    const Vec3 q = a + (b - a) * (static_cast<double>(i) / pieces);
+                    const double d = wear::locate_on_surface(w.surface->mesh(), q).distance_m;
+                    if (d > kMeasuredPointTolerance_m)
+                        throw InputError(concat(section.where, ": section '", section.name, "' passes (", q.x, ", ", q.y, ", ", q.z,
+                                                ") m, ", d, " m from the surface of '", spec.part,
+                                                "' (in the part's own frame); expected within ", kMeasuredPointTolerance_m, " m"));
+                }
             }
         wear_.push_back(std::move(w));
     }
@@ -349,10 +375,17 @@ void RigidScene::track_passes()
     if (!has_shovel()) return;
     const rigid::ShovelReading& r = reading();
     const double t = coupled_->time_s(), dt = coupled_->coupling_step_s();
-    // the dig phase: the swing at rest, the door shut, and the hoist rope being hauled in
-    const rigid::MotionSample now = motion_->at(t), before = motion_->at(t - dt);
-    const bool hauling = now.hoist_length_m < before.hoist_length_m;
-    if (!door_open_ && std::abs(now.swing_deg) < 2.0 && now.door_deg < 1.0 && hauling) {
+    // the dig phase: a built-in cycle's digs by their times; with a motion file, the swing at rest, the
+    // door shut, and the hoist rope being hauled in
+    bool digging = false;
+    if (cycle_period_s_ > 0.0) {
+        const double local = t - cycle_start_s_;
+        digging = local > 0.0 && local - std::floor(local / cycle_period_s_) * cycle_period_s_ <= cycle_dig_s_;
+    } else {
+        const rigid::MotionSample now = motion_->at(t), before = motion_->at(t - dt);
+        digging = std::abs(now.swing_deg) < 2.0 && now.door_deg < 1.0 && now.hoist_length_m < before.hoist_length_m;
+    }
+    if (!door_open_ && digging) {
         dig_force_sum_ += r.dig_force_N;
         dig_force_peak_ = std::max(dig_force_peak_, r.dig_force_N);
         if (dig_samples_++ == 0) dig_start_s_ = t;

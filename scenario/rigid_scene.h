@@ -46,10 +46,10 @@ struct SceneWear {
     rigid::BodyId body = -1;    ///< Bullet body whose rock contacts it sums (-1: none)
 };
 
-/// The default three-pass cycle (rigid::default_loading_cycle, passes of 46 s that start with a 15 s dig)
-/// with each dig done `factor` times faster; what follows a dig keeps its duration, so a pass lasts
-/// 31 s + 15 s / factor. The positions the curves pass through do not change.
-rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor);
+/// A built-in cycle (passes of `pass_s` that each start with a dig of rigid::kBuiltInDig_s) with each dig
+/// done `factor` times faster; what follows a dig keeps its duration, so a pass lasts
+/// pass_s - 15 s + 15 s / factor. The positions the curves pass through do not change.
+rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double factor, double pass_s = rigid::kDefaultCyclePass_s);
 
 class RigidScene {
 public:
@@ -131,6 +131,8 @@ private:
     bool door_open_ = false;
     double pass_start_s_ = 0.0, dig_start_s_ = -1.0, dig_end_s_ = -1.0, dig_force_sum_ = 0.0, dig_force_peak_ = 0.0;
     std::uint64_t dig_samples_ = 0;
+    // a built-in cycle's digs: [start + k period, start + k period + dig]; period 0: a motion file
+    double cycle_start_s_ = 0.0, cycle_period_s_ = 0.0, cycle_dig_s_ = 0.0;
 };
 
 }  // namespace dipper::scenario

@@ -244,6 +244,7 @@ public:
         if (rigid_) {
             write_wear_maps();
             compare_measured_wear();  // the points were checked against the surfaces before the run
+            write_wear_sections();
         }
         result.time_s = world_->time_s();
         result.steps = world_->step_count();
@@ -434,6 +435,29 @@ private:
         }
     }
 
+    /// Each section's simulated rate profile with the measured points near it, in
+    /// wear_<part>_section_<name>.csv (the run's constant; the calibrated one scales it by `scale`).
+    void write_wear_sections()
+    {
+        sections_.clear();
+        for (std::size_t k = 0; k < rigid_->wear().size(); ++k) {
+            const SceneWear& sw = rigid_->wear()[k];
+            sections_.emplace_back();
+            if (sw.spec.sections.empty() || !(rigid_->tonnage_t(sw) > 0.0)) continue;
+            const wear::RateMap map(*sw.surface, rigid_->tonnage_t(sw), sw.spec.smoothing_iterations);
+            const std::vector<wear::PointComparison> none;
+            const auto& measured = k < calibrations_.size() && calibrations_[k].scale > 0.0 ? calibrations_[k].before : none;
+            for (const WearSectionSpec& section : sw.spec.sections) {
+                SectionResult r;
+                r.name = section.name;
+                r.profile = wear::sample_section(map, section.points_m, section.spacing_m, kMeasuredPointTolerance_m, section.name);
+                r.measured = wear::points_on_section(section.points_m, measured, kMeasuredPointTolerance_m);
+                wear::write_section_csv(dir_ + "/wear_" + sw.spec.part + "_section_" + section.name + ".csv", r.profile, r.measured);
+                sections_.back().push_back(std::move(r));
+            }
+        }
+    }
+
     void checkpoint()
     {
         StateWriter out;
@@ -581,6 +605,30 @@ private:
                     << ", \"calibrated_constant_low\": " << json_number(c.constant_low)
                     << ", \"calibrated_constant_high\": " << json_number(c.constant_high) << "}";
             }
+            if (k < sections_.size() && !sections_[k].empty()) {
+                out << ", \"sections\": {";
+                for (std::size_t q = 0; q < sections_[k].size(); ++q) {
+                    const SectionResult& sr = sections_[k][q];
+                    double sum = 0.0, peak = 0.0, measured_sum = 0.0, simulated_at_points = 0.0;
+                    for (const wear::SectionSample& x : sr.profile) {
+                        sum += x.simulated_rate;
+                        peak = std::max(peak, x.simulated_rate);
+                    }
+                    for (const wear::SectionPoint& m : sr.measured) {
+                        measured_sum += m.comparison.measured_rate;
+                        simulated_at_points += m.comparison.simulated_rate;
+                    }
+                    const double n = static_cast<double>(sr.measured.size());
+                    out << (q ? ", " : "") << "\"" << json_escape(sr.name) << "\": {\"samples\": " << sr.profile.size()
+                        << ", \"mean_simulated_mm_per_t\": " << json_number(sum / static_cast<double>(sr.profile.size()))
+                        << ", \"max_simulated_mm_per_t\": " << json_number(peak) << ", \"measured_points\": " << sr.measured.size();
+                    if (n > 0)
+                        out << ", \"mean_measured_mm_per_t\": " << json_number(measured_sum / n)
+                            << ", \"mean_simulated_at_points_mm_per_t\": " << json_number(simulated_at_points / n);
+                    out << "}";
+                }
+                out << "}";
+            }
             out << "}";
         }
         out << "}";
@@ -592,6 +640,12 @@ private:
     std::unique_ptr<dem::World> world_;
     std::unique_ptr<RigidScene> rigid_;  ///< rocks, shovel and wear; null for spheres and walls only
     std::vector<wear::CalibrationResult> calibrations_;  ///< per wear surface, at the end (scale 0: none)
+    struct SectionResult {
+        std::string name;
+        std::vector<wear::SectionSample> profile;
+        std::vector<wear::SectionPoint> measured;
+    };
+    std::vector<std::vector<SectionResult>> sections_;  ///< per wear surface, at the end
     std::vector<int> walls_;             ///< the walls outputs list
     std::vector<dem::Pourer> pourers_;
     std::unique_ptr<dem::PvdCollection> particles_pvd_;

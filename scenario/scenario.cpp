@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace dipper::scenario {
@@ -174,6 +175,30 @@ public:
         if (!n.IsSequence()) fail(key, shown(n), "a list of maps");
         for (std::size_t k = 0; k < n.size(); ++k)
             out.emplace_back(n[k], child_spec(key) + "[]", concat(full(key), "[", k, "]"), source_, n[k].Mark());
+        return out;
+    }
+
+    /// A list of at least `min_count` points [x, y, z].
+    std::vector<Vec3> vector3_list(const std::string& key, std::size_t min_count) const
+    {
+        spec_of(key);
+        const std::string expected = concat("a list of at least ", min_count, " points [x, y, z]");
+        if (!has(key)) fail(key, "nothing", expected);
+        const YAML::Node n = *find(key);
+        if (!n.IsSequence() || n.size() < min_count) fail(key, shown(n), expected);
+        std::vector<Vec3> out;
+        for (const auto& item : n) {
+            if (!item.IsSequence() || item.size() != 3) fail(key, shown(n), expected);
+            Vec3 v;
+            for (int a = 0; a < 3; ++a) {
+                const std::string text = item[a].IsScalar() ? item[a].Scalar() : "";
+                char* end = nullptr;
+                const double x = std::strtod(text.c_str(), &end);
+                if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x)) fail(key, shown(n), expected);
+                (a == 0 ? v.x : a == 1 ? v.y : v.z) = x;
+            }
+            out.push_back(v);
+        }
         return out;
     }
 
@@ -382,7 +407,8 @@ ShovelSpec read_shovel(const Scenario& s, const MapReader& m)
     require_in_range(sh.element_size_m, 0.02, 1.0, "element_size_m", m.where("element_size_m"));
     sh.material = material_known(s, m, "material", true);
     sh.motion = m.text("motion");
-    if (sh.motion != "default_cycle") sh.motion = resolved(s.base_dir, sh.motion);
+    const bool built_in = sh.motion == "default_cycle" || sh.motion == "dig_and_return";
+    if (!built_in) sh.motion = resolved(s.base_dir, sh.motion);
     const std::int64_t passes = m.integer("passes");
     if (passes < 0 || passes > 1000) m.fail("passes", concat(passes), "0 (run for time.duration_s) or a number of passes");
     sh.passes = static_cast<int>(passes);
@@ -390,8 +416,13 @@ ShovelSpec read_shovel(const Scenario& s, const MapReader& m)
     require_non_negative(sh.start_s, "start_s", m.where("start_s"));
     sh.dig_speed_factor = m.number("dig_speed_factor");
     require_in_range(sh.dig_speed_factor, 0.5, 2.0, "dig_speed_factor", m.where("dig_speed_factor"));
-    if (sh.dig_speed_factor != 1.0 && m.text("motion") != "default_cycle")
-        m.fail("dig_speed_factor", concat(sh.dig_speed_factor), "1 with a motion file (the factor reshapes the default cycle only)");
+    if (sh.dig_speed_factor != 1.0 && !built_in)
+        m.fail("dig_speed_factor", concat(sh.dig_speed_factor), "1 with a motion file (the factor reshapes the built-in cycles only)");
+    sh.advance_per_pass_m = m.number("advance_per_pass_m");
+    require_in_range(sh.advance_per_pass_m, 0.0, 10.0, "advance_per_pass_m", m.where("advance_per_pass_m"));
+    if (sh.advance_per_pass_m != 0.0 && sh.motion != "default_cycle")
+        m.fail("advance_per_pass_m", concat(sh.advance_per_pass_m),
+               "0 unless shovel.motion is default_cycle (a motion file moves the machine with its propel_m column)");
     sh.bulk_density_kg_per_m3 = m.number("bulk_density_kg_per_m3");
     require_positive(sh.bulk_density_kg_per_m3, "bulk_density_kg_per_m3", m.where("bulk_density_kg_per_m3"));
     sh.where = m.where("motion");
@@ -499,10 +530,19 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         pour.rate_kg_per_s = p.number("rate_kg_per_s");
         require_positive(pour.rate_kg_per_s, "rate_kg_per_s", p.where("rate_kg_per_s"));
         pour.velocity_m_per_s = p.vector3("velocity_m_per_s");
+        pour.start_s = p.number("start_s");
+        require_non_negative(pour.start_s, "start_s", p.where("start_s"));
         s.pours.push_back(pour);
     }
     if (s.fills.empty() && s.pours.empty() && s.pile.empty())
         throw InputError(concat(s.source, ": the scenario has no particles; add a 'fills', 'pours' or 'pile' entry"));
+    if (s.fills.empty() && s.pile.empty() && s.step_s == 0.0) {
+        double first_s = std::numeric_limits<double>::infinity();
+        for (const PourSpec& p : s.pours) first_s = std::min(first_s, p.start_s);
+        if (first_s > 0.0)
+            throw InputError(concat(s.pours.front().where, ": no particle exists before the first pour starts at t = ", first_s,
+                                    " s, so the default time step cannot be derived; set time.step_s or let a pour start at 0"));
+    }
 
     const MapReader coupling = top.map("coupling");
     const std::int64_t substeps = coupling.integer("substeps");
@@ -542,6 +582,23 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
             } catch (const InputError& e) {
                 throw InputError(concat(w.where("measured_file"), ": ", e.what()));
             }
+        }
+        for (const MapReader& sec : w.maps("sections")) {
+            WearSectionSpec section;
+            section.where = sec.where("name");
+            section.name = sec.text("name");
+            if (section.name.empty() || section.name.find_first_not_of(
+                                            "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
+                sec.fail("name", concat("\"", section.name, "\""), "a name of letters, digits, '_' and '-' (it names a file)");
+            for (const WearSectionSpec& other : spec.sections)
+                if (other.name == section.name) sec.fail("name", concat("\"", section.name, "\""), "each section name once per part");
+            section.points_m = sec.vector3_list("points_m", 2);
+            for (std::size_t k = 0; k + 1 < section.points_m.size(); ++k)
+                if (norm(section.points_m[k + 1] - section.points_m[k]) < 1e-6)
+                    sec.fail("points_m", concat("points ", k, " and ", k + 1, " at the same place"), "distinct consecutive points");
+            section.spacing_m = sec.number("spacing_m");
+            require_in_range(section.spacing_m, 1e-3, 10.0, "spacing_m", sec.where("spacing_m"));
+            spec.sections.push_back(section);
         }
         s.wear.push_back(spec);
     }
@@ -718,7 +775,7 @@ std::vector<dem::Pourer> make_pourers(const Scenario& s, const dem::World& world
     for (std::size_t k = 0; k < s.pours.size(); ++k) {
         const PourSpec& p = s.pours[k];
         pourers.emplace_back(dem::BoxRegion(p.min_m, p.max_m), p.sizes, world.materials().index_of(p.material),
-                             p.rate_kg_per_s, p.mass_kg, p.velocity_m_per_s, s.seed * 7919ull + 17ull * k + 1ull);
+                             p.rate_kg_per_s, p.mass_kg, p.velocity_m_per_s, s.seed * 7919ull + 17ull * k + 1ull, p.start_s);
     }
     return pourers;
 }

@@ -56,6 +56,7 @@ struct FillSpec : ParticleSource {
 struct PourSpec : ParticleSource {
     double rate_kg_per_s = 0.0;
     Vec3 velocity_m_per_s;
+    double start_s = 0.0;  ///< nothing enters before this time
 };
 
 struct RegionProbe {
@@ -75,17 +76,28 @@ struct ShovelSpec {
     double start_s = 0.0;
     int passes = 0;  ///< > 0: the run ends 1 s after this pass's dump
     double dig_speed_factor = 1.0;
+    double advance_per_pass_m = 0.0;  ///< the default cycle's propel after each dump
     double bulk_density_kg_per_m3 = 1903.0;
     std::string where;
 };
 
 /// A wear surface on a machine part.
+/// A line across a wear surface along which the wear rate is written and compared with the measured
+/// points near it (thesis Paper B Fig. 16).
+struct WearSectionSpec {
+    std::string name;
+    std::vector<Vec3> points_m;  ///< polyline in the part's own frame, at least two points
+    double spacing_m = 0.05;
+    std::string where;
+};
+
 struct WearSpec {
     std::string part, law;
     double constant = 0.0;
     int smoothing_iterations = 2;
     double tonnage_t = 0.0;       ///< 0: the shovel's passes
     std::string measured_file;    ///< absolute path, or empty
+    std::vector<WearSectionSpec> sections;
     std::string where;
 };
 
@@ -143,7 +155,7 @@ void check_pairs(const Scenario& scenario);
 /// Places the particles of the fills without rocks (seeded by the scenario's seed and the fill's position
 /// in the list), clear of the walls. Fills with rocks are placed by RigidScene::fill_mixed.
 void build_particles(const Scenario& scenario, dem::World& world);
-/// The pours, ready to run from t = 0.
+/// The pours, ready to run from t = 0 (each waits for its start_s).
 std::vector<dem::Pourer> make_pourers(const Scenario& scenario, const dem::World& world);
 
 }  // namespace dipper::scenario

@@ -149,6 +149,9 @@ struct RigidWorld::Impl {
         checked_bodies = bodies.size();
     }
 
+    /// Broadphase group of the rope shovel's links: fixed and kinematic bodies can leave it out of their mask.
+    static constexpr int kMachineFilter = 64;
+
     BodyId insert(std::unique_ptr<Body> b, double mass, const btVector3& inertia, const btTransform& pose)
     {
         b->motion = std::make_unique<btDefaultMotionState>(pose);

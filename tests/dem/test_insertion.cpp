@@ -93,3 +93,28 @@ TEST_CASE("pouring delivers its mass at the set rate", "[dem][insertion][unit]")
     CHECK(w.time_s() < 0.25 + 60 * w.step_s());
     CHECK(std::abs(pour.poured_mass_kg() - 100.0) <= sphere_mass_kg(0.05, 3700.0));
 }
+
+TEST_CASE("a pour with a start time waits for it, then delivers at its rate", "[dem][insertion][unit]")
+{
+    WorldSettings settings;
+    settings.step_s = 2e-5;  // fixed: the world is empty until the pour starts
+    World w(MaterialTable::aitik_copper_ore(), settings);
+    w.add_plane({0, 0, 0}, {0, 0, 1}, w.materials().index_of("ground"), "floor");
+    Pourer pour(BoxRegion({0, 0, 1.0}, {1.0, 1.0, 1.5}), {{{0.05, 1.0}}}, w.materials().index_of("ore"), 400.0, 100.0,
+                {0.0, 0.0, -1.0}, 9, 0.1);
+    double first_s = -1.0;
+    while (!pour.done() && w.time_s() < 2.0) {
+        if (pour.update(w) > 0 && first_s < 0.0) first_s = w.time_s();
+        w.step();
+    }
+    REQUIRE(pour.done());
+    // the first particle enters at the first call at or after 0.1 s (calls every step), and the 100 kg at
+    // 400 kg/s are due 0.25 s later; the last particle's mass is reached one call late at most
+    CHECK(first_s >= 0.1);
+    CHECK(first_s < 0.1 + 1.5 * w.step_s());
+    CHECK(w.time_s() < first_s + 0.25 + 2.0 * w.step_s());
+    CHECK(w.time_s() > first_s + 0.25 - sphere_mass_kg(0.05, 3700.0) / 400.0 - w.step_s());
+    REQUIRE_THROWS_WITH(Pourer(BoxRegion({0, 0, 1.0}, {1.0, 1.0, 1.5}), {{{0.05, 1.0}}}, w.materials().index_of("ore"), 400.0,
+                               100.0, {}, 9, -1.0),
+                        Catch::Contains("start_s = -1"));
+}

@@ -136,6 +136,35 @@ TEST_CASE("a rotating mesh wall moves its vertices and reports the rigid velocit
     CHECK(v.x == Approx(-2.0).epsilon(1e-12));
 }
 
+TEST_CASE("the bound on a moved mesh's vertex travel is never below the true travel, and exact for a shift",
+          "[dem][walls][unit]")
+{
+    // the neighbour lists rebuild when a mesh may have moved its vertices by the skin: the bound from two
+    // poses must cover every vertex; a pure translation moves every vertex by exactly |dT|
+    MeshWall m(meshes::make_box_mesh({0.0, 0.0, -1.0}, {2.0, 1.0, 0.5}), 1, "box");
+    const Mat3 r0 = rotation_about_axis(normalized(Vec3{1.0, 2.0, 3.0}), 0.7);
+    const Vec3 t0{0.3, -1.0, 2.0};
+    m.set_pose(r0, t0, {}, {}, {});
+    const std::vector<Vec3> before = m.vertices_world_m();
+    m.set_pose(r0, t0 + Vec3{0.01, -0.02, 0.005}, {}, {}, {});
+    CHECK(m.max_vertex_move_m(r0, t0) == Approx(norm(Vec3{0.01, -0.02, 0.005})).epsilon(1e-12));
+    double worst_ratio = 1e300;
+    for (int k = 1; k <= 200; ++k) {
+        const double angle = 1e-4 * k * k;  // 1e-4 to 4 rad
+        const Mat3 r = rotation_about_axis(normalized(Vec3{std::sin(1.0 * k), std::cos(3.0 * k), 0.5}), angle) * r0;
+        const Vec3 t = t0 + Vec3{1e-3 * std::sin(2.0 * k), 0.0, 1e-3 * k};
+        m.set_pose(r, t, {}, {}, {});
+        const auto& after = m.vertices_world_m();
+        double travel = 0.0;
+        for (std::size_t v = 0; v < after.size(); ++v) travel = std::max(travel, norm(after[v] - before[v]));
+        const double bound = m.max_vertex_move_m(r0, t0);
+        CHECK(bound >= travel * (1.0 - 1e-12));
+        worst_ratio = std::min(worst_ratio, travel / bound);
+    }
+    // and not wildly conservative: it asks for a rebuild at most about twice as early as needed
+    CHECK(worst_ratio > 0.4);
+}
+
 TEST_CASE("contact records carry force, point and relative displacement of a sliding sphere", "[dem][walls][unit]")
 {
     // A sphere pushed along a mesh floor slides at 1 m/s with mu 0.5 (no rolling: spin locked by a high

@@ -68,7 +68,20 @@ TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the
     e = error_of(base("shovel: {wear_bars: zigzag}\n"));
     CHECK_THAT(e, Catch::Contains("shovel.wear_bars: got \"zigzag\"; expected baseline, transverse or diagonal"));
     e = error_of(base("shovel: {motion: curves.csv, dig_speed_factor: 1.2}\n"));
-    CHECK_THAT(e, Catch::Contains("shovel.dig_speed_factor") && Catch::Contains("default cycle only"));
+    CHECK_THAT(e, Catch::Contains("shovel.dig_speed_factor") && Catch::Contains("built-in cycles only"));
+    CHECK(parse_scenario(base("shovel: {motion: dig_and_return, dig_speed_factor: 1.2}\n"), "case.yaml", ".").shovel->motion ==
+          "dig_and_return");
+    CHECK(parse_scenario(base("shovel: {advance_per_pass_m: 2.5}\n"), "case.yaml", ".").shovel->advance_per_pass_m == 2.5);
+    e = error_of(base("shovel: {motion: dig_and_return, advance_per_pass_m: 2}\n"));
+    CHECK_THAT(e, Catch::Contains("shovel.advance_per_pass_m: got 2; expected 0 unless shovel.motion is default_cycle"));
+    e = error_of(base("shovel: {advance_per_pass_m: -1}\n"));
+    CHECK_THAT(e, Catch::Contains("shovel.advance_per_pass_m") && Catch::Contains("-1"));
+    e = error_of(base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12, sections: [{name: front, points_m: [[1, 0, 0]]}]}\n"));
+    CHECK_THAT(e, Catch::Contains("wear[0].sections[0].points_m") && Catch::Contains("a list of at least 2 points"));
+    e = error_of(base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12, sections: [{name: a b, points_m: [[1, 0, 0], [1, 1, 0]]}]}\n"));
+    CHECK_THAT(e, Catch::Contains("wear[0].sections[0].name: got \"a b\"") && Catch::Contains("it names a file"));
+    e = error_of(base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12, sections: [{name: a, points_m: [[1, 0, 0], [1, 0, 0]]}]}\n"));
+    CHECK_THAT(e, Catch::Contains("wear[0].sections[0].points_m: got points 0 and 1 at the same place"));
     e = error_of(base("shovel: {}\nwear:\n  - {part: boom, constant: 1.0e-12}\n"));
     CHECK_THAT(e, Catch::Contains("wear[0].part: got \"boom\"; expected one of the parts: dipper, door"));
     e = error_of(base("wear:\n  - {part: dipper, constant: 1.0e-12}\n"));
@@ -304,6 +317,31 @@ TEST_CASE("measured wear: compared and calibrated at the end of a run; points of
     while (std::getline(points, line)) ++rows;
     CHECK(rows == 5);  // header and four points
 
+    // the section y = -0.5 from x = -0.9 to 0.9: 19 samples 0.1 m apart, and the measured points a and b on it
+    std::ifstream section(dir + "/wear_floor_section_south.csv");
+    std::getline(section, line);
+    CHECK(line == "kind,arc_length_m,x_m,y_m,z_m,simulated_mm_per_t,measured_mm_per_t,id");
+    std::vector<std::vector<std::string>> simulated_rows, measured_rows;
+    while (std::getline(section, line)) {
+        std::vector<std::string> f;
+        std::stringstream ss(line);
+        std::string cell;
+        while (std::getline(ss, cell, ',')) f.push_back(cell);
+        (f[0] == "simulated" ? simulated_rows : measured_rows).push_back(f);
+    }
+    REQUIRE(simulated_rows.size() == 19);
+    REQUIRE(measured_rows.size() == 2);
+    CHECK(measured_rows[0][7] == "a");
+    CHECK(std::stod(measured_rows[0][1]) == Approx(0.4).margin(1e-12));
+    CHECK(measured_rows[1][7] == "b");
+    CHECK(std::stod(measured_rows[1][1]) == Approx(1.4).margin(1e-12));
+    CHECK(std::stod(measured_rows[1][6]) == Approx(0.3 / 0.3).epsilon(1e-9));
+    // the profile at a point's arc length is the map's rate at that point
+    CHECK(std::stod(simulated_rows[4][5]) == Approx(std::stod(measured_rows[0][5])).epsilon(1e-6));
+    CHECK(std::stod(simulated_rows[14][5]) == Approx(std::stod(measured_rows[1][5])).epsilon(1e-6));
+    CHECK(number("measured_points") == 2);
+    CHECK(number("mean_measured_mm_per_t") == Approx((0.2 + 0.3 + 0.2 + 0.4) / 4.0 / 0.3).epsilon(1e-9));  // the file's first
+
     // a point 0.5 m above the floor belongs to no part: refused before anything runs
     const fs::path bad = fs::temp_directory_path() / "dipper_wear_floor_bad.csv";
     {
@@ -313,6 +351,11 @@ TEST_CASE("measured wear: compared and calibrated at the end of a run; points of
     Scenario sc = load_scenario(file);
     sc.wear[0].measured_file = bad.string();
     CHECK_THROWS_WITH(run_scenario(sc, dir, o), Catch::Contains("measured point 'high'") && Catch::Contains("0.5 m from the surface of 'floor'"));
+    // a section that leaves the part: refused before anything runs, with its key
+    Scenario off = load_scenario(file);
+    off.wear[0].sections[0].points_m[1] = {0.9, -0.5, 0.5};
+    CHECK_THROWS_WITH(run_scenario(off, dir, o), Catch::Contains("wear[0].sections[0].name") && Catch::Contains("section 'south'") &&
+                                                     Catch::Contains("from the surface of 'floor'"));
     fs::remove_all(dir);
     fs::remove(bad);
 }
@@ -421,6 +464,40 @@ TEST_CASE("a pile saved cut at a height and loaded by another scenario holds wha
     }
     CHECK_THAT(e, Catch::Contains("pile: got \"nowhere.txt\"; expected a saved pile file"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("the dig-and-return cycle digs like the default cycle, empties the dipper where the dig ends, and repeats",
+          "[scenario][shovel]")
+{
+    const rigid::ShovelGeometry g;
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    const rigid::MotionCurves loading = rigid::default_loading_cycle(g, dipper);
+    const rigid::MotionCurves wear = rigid::dig_and_return_cycle(g, dipper, 4);
+    CHECK(wear.duration_s() == Approx(3 * rigid::kDigAndReturnPass_s + 29.99).epsilon(1e-12));
+    for (int k = 0; k < 4; ++k) {
+        const double t0 = k * rigid::kDigAndReturnPass_s;
+        // the dig: the same hoist and crowd as the default cycle's first dig, every 0.5 s
+        for (double t = 0.0; t <= rigid::kBuiltInDig_s; t += 0.5) {
+            const rigid::MotionSample a = loading.at(t), b = wear.at(t0 + t);
+            CHECK(b.hoist_length_m == Approx(a.hoist_length_m).epsilon(1e-12));
+            CHECK(b.crowd_extension_m == Approx(a.crowd_extension_m).epsilon(1e-12));
+            CHECK(b.door_deg == 0.0);
+        }
+        // lowered in front of the bank, the door opens 60 deg without any swing, then shuts before the
+        // dipper is back at the toe
+        const rigid::ShovelPose dump = rigid::pose_shovel(g, dipper, 20.0, 3.0);
+        CHECK(wear.at(t0 + 22.0).door_deg == Approx(60.0));
+        CHECK(wear.at(t0 + 22.0).hoist_length_m == Approx(dump.rope_length_m).epsilon(1e-12));
+        CHECK(wear.at(t0 + 22.0).crowd_extension_m == Approx(3.0).epsilon(1e-12));
+        CHECK(wear.at(t0 + 19.0).door_deg == 0.0);
+        CHECK(wear.at(t0 + 25.5).door_deg == 0.0);
+        CHECK(wear.at(t0 + 29.5).hoist_length_m == Approx(loading.at(0.0).hoist_length_m).epsilon(1e-12));
+        for (double t = 0.0; t < rigid::kDigAndReturnPass_s; t += 0.25) CHECK(wear.at(t0 + t).swing_deg == 0.0);
+    }
+    CHECK_THROWS_WITH(rigid::dig_and_return_cycle(g, dipper, 0), Catch::Contains("cycles = 0"));
+    // a faster dig keeps the pass's other 15 s
+    const rigid::MotionCurves fast = dig_speed_scaled(wear, 1.5, rigid::kDigAndReturnPass_s);
+    CHECK(fast.duration_s() == Approx(3 * (15.0 + 10.0) + 29.99 - 15.0 + 10.0).epsilon(1e-12));
 }
 
 TEST_CASE("a faster dig shortens each pass's dig and keeps the poses and the rest of the cycle", "[scenario][shovel]")

@@ -147,6 +147,14 @@ TEST_CASE("every class of scenario error names file, line, column, key, value an
     CHECK_THAT(e, Catch::Contains("pours[0].sizes"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("max_m: \\[1, 1, 0.5\\]"), "max_m: [1, 1, -0.5]"));
     CHECK_THAT(e, Catch::Contains("fills[0].box.max_m: got [1, 1, -0.5]; expected each coordinate above min_m"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("    rate_kg_per_s: 1000\n"), "    rate_kg_per_s: 1000\n    start_s: -2\n"));
+    CHECK_THAT(e, Catch::Contains("pours[0].start_s") && Catch::Contains("-2"));
+    // only pours, the first at 0.5 s: no particle to derive the default step from
+    const std::string late_pour = std::regex_replace(
+        std::regex_replace(small_scenario(), std::regex("fills:\n  - mass_kg: 300\n    box: \\{min_m: \\[0, 0, 0\\], max_m: \\[1, 1, 0.5\\]\\}\n    sizes: \\[\\{radius_m: 0.05, mass_fraction: 0.5\\}, \\{radius_m: 0.04, mass_fraction: 0.5\\}\\]\n"), ""),
+        std::regex("    rate_kg_per_s: 1000\n"), "    rate_kg_per_s: 1000\n    start_s: 0.5\n");
+    REQUIRE(late_pour.find("fills:") == std::string::npos);
+    CHECK_THAT(error_of(late_pour), Catch::Contains("first pour starts at t = 0.5 s") && Catch::Contains("time.step_s"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("dipper_scenario: 1"), "dipper_scenario: 2"));
     CHECK_THAT(e, Catch::Contains("case.yaml:1:18: dipper_scenario: got 2; expected 1"));
 
