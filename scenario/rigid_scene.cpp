@@ -213,17 +213,12 @@ void RigidScene::add_wear(const Scenario& s)
                                             "' (in the part's own frame); expected within ", kMeasuredPointTolerance_m, " m"));
             }
         for (const WearSectionSpec& section : spec.sections)
-            for (std::size_t k = 0; k + 1 < section.points_m.size(); ++k) {
-                const Vec3 a = section.points_m[k], b = section.points_m[k + 1];
-                const int pieces = std::max(1, static_cast<int>(std::ceil(norm(b - a) / section.spacing_m - 1e-9)));
-                for (int i = 0; i <= pieces; ++i) {
-                    const Vec3 q = a + (b - a) * (static_cast<double>(i) / pieces);
-                    const double d = wear::locate_on_surface(w.surface->mesh(), q).distance_m;
-                    if (d > kMeasuredPointTolerance_m)
-                        throw InputError(concat(section.where, ": section '", section.name, "' passes (", q.x, ", ", q.y, ", ", q.z,
-                                                ") m, ", d, " m from the surface of '", spec.part,
-                                                "' (in the part's own frame); expected within ", kMeasuredPointTolerance_m, " m"));
-                }
+            for (const auto& [arc, q] : wear::section_points(section.points_m, section.spacing_m)) {
+                const double d = wear::locate_on_surface(w.surface->mesh(), q).distance_m;
+                if (d > kMeasuredPointTolerance_m)
+                    throw InputError(concat(section.where, ": section '", section.name, "' passes (", q.x, ", ", q.y, ", ", q.z, ") m, ",
+                                            arc, " m along it, ", d, " m from the surface of '", spec.part,
+                                            "' (in the part's own frame); expected within ", kMeasuredPointTolerance_m, " m"));
             }
         wear_.push_back(std::move(w));
     }

@@ -143,16 +143,8 @@ public:
     Vec3 vector3(const std::string& key) const
     {
         const YAML::Node n = has(key) ? *find(key) : YAML::Load(default_of(key));
-        if (!n.IsSequence() || n.size() != 3) fail(key, shown(n), concat("a list of 3 numbers [x, y, z]", unit_hint(key)));
         Vec3 v;
-        for (int a = 0; a < 3; ++a) {
-            const std::string text = n[a].IsScalar() ? n[a].Scalar() : "";
-            char* end = nullptr;
-            const double x = std::strtod(text.c_str(), &end);
-            if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x))
-                fail(key, shown(n), concat("a list of 3 finite numbers [x, y, z]", unit_hint(key)));
-            (a == 0 ? v.x : a == 1 ? v.y : v.z) = x;
-        }
+        if (!point_of(n, v)) fail(key, shown(n), concat("a list of 3 finite numbers [x, y, z]", unit_hint(key)));
         return v;
     }
 
@@ -186,19 +178,9 @@ public:
         if (!has(key)) fail(key, "nothing", expected);
         const YAML::Node n = *find(key);
         if (!n.IsSequence() || n.size() < min_count) fail(key, shown(n), expected);
-        std::vector<Vec3> out;
-        for (const auto& item : n) {
-            if (!item.IsSequence() || item.size() != 3) fail(key, shown(n), expected);
-            Vec3 v;
-            for (int a = 0; a < 3; ++a) {
-                const std::string text = item[a].IsScalar() ? item[a].Scalar() : "";
-                char* end = nullptr;
-                const double x = std::strtod(text.c_str(), &end);
-                if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x)) fail(key, shown(n), expected);
-                (a == 0 ? v.x : a == 1 ? v.y : v.z) = x;
-            }
-            out.push_back(v);
-        }
+        std::vector<Vec3> out(n.size());
+        for (std::size_t k = 0; k < n.size(); ++k)
+            if (!point_of(n[k], out[k])) fail(key, shown(n), expected);
         return out;
     }
 
@@ -239,6 +221,19 @@ private:
     std::string position(const YAML::Mark& m) const
     {
         return concat(source_, ":", m.line + 1, ":", m.column + 1, ": ");
+    }
+    /// A YAML list of exactly three finite numbers; false if it is anything else.
+    static bool point_of(const YAML::Node& n, Vec3& v)
+    {
+        if (!n.IsSequence() || n.size() != 3) return false;
+        for (int a = 0; a < 3; ++a) {
+            const std::string text = n[a].IsScalar() ? n[a].Scalar() : "";
+            char* end = nullptr;
+            const double x = std::strtod(text.c_str(), &end);
+            if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(x)) return false;
+            (a == 0 ? v.x : a == 1 ? v.y : v.z) = x;
+        }
+        return true;
     }
     static std::string shown(const YAML::Node& n)
     {

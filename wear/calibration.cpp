@@ -218,12 +218,9 @@ CalibrationResult calibrate(const WearSurface& trial, double simulated_tonnage_t
     return r;
 }
 
-std::vector<SectionSample> sample_section(const RateMap& map, const std::vector<Vec3>& line, double spacing_m,
-                                          double tolerance_m, const std::string& name)
+std::vector<std::pair<double, Vec3>> section_points(const std::vector<Vec3>& line, double spacing_m)
 {
-    if (line.size() < 2) throw InputError(concat("section '", name, "': needs at least 2 points; got ", line.size()));
-    require_positive(spacing_m, "section spacing (m)", concat("section '", name, "'"));
-    std::vector<SectionSample> out;
+    std::vector<std::pair<double, Vec3>> out;
     double s0 = 0.0;
     for (std::size_t k = 0; k + 1 < line.size(); ++k) {
         const Vec3 a = line[k], ab = line[k + 1] - line[k];
@@ -231,14 +228,25 @@ std::vector<SectionSample> sample_section(const RateMap& map, const std::vector<
         const int pieces = std::max(1, static_cast<int>(std::ceil(length / spacing_m - 1e-9)));
         for (int i = (k == 0 ? 0 : 1); i <= pieces; ++i) {
             const double u = static_cast<double>(i) / pieces;
-            const Vec3 q = a + ab * u;
-            SectionSample s;
-            s.arc_length_m = s0 + u * length;
-            s.point_m = locate_on_surface(map.surface->mesh(), q).point_m;
-            s.simulated_rate = map.at(q, tolerance_m, concat("section '", name, "' at ", s.arc_length_m, " m"));
-            out.push_back(s);
+            out.emplace_back(s0 + u * length, a + ab * u);
         }
         s0 += length;
+    }
+    return out;
+}
+
+std::vector<SectionSample> sample_section(const RateMap& map, const std::vector<Vec3>& line, double spacing_m,
+                                          double tolerance_m, const std::string& name)
+{
+    if (line.size() < 2) throw InputError(concat("section '", name, "': needs at least 2 points; got ", line.size()));
+    require_positive(spacing_m, "section spacing (m)", concat("section '", name, "'"));
+    std::vector<SectionSample> out;
+    for (const auto& [arc, q] : section_points(line, spacing_m)) {
+        SectionSample s;
+        s.arc_length_m = arc;
+        s.point_m = locate_on_surface(map.surface->mesh(), q).point_m;
+        s.simulated_rate = map.at(q, tolerance_m, concat("section '", name, "' at ", arc, " m"));
+        out.push_back(s);
     }
     return out;
 }

@@ -5,6 +5,7 @@
 #include "wear/wear_surface.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dipper::wear {
@@ -92,6 +93,9 @@ struct SectionSample {
 };
 std::vector<SectionSample> sample_section(const RateMap& map, const std::vector<Vec3>& polyline_m, double spacing_m,
                                           double tolerance_m, const std::string& section_name);
+/// Where sample_section samples: points along the polyline at most `spacing_m` apart, each piece split
+/// evenly, with their arc length (first: 0 at the first point).
+std::vector<std::pair<double, Vec3>> section_points(const std::vector<Vec3>& polyline_m, double spacing_m);
 /// The measured points within `distance_m` of the polyline, with their arc length along it.
 struct SectionPoint {
     double arc_length_m;

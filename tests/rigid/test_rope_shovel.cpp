@@ -333,3 +333,33 @@ TEST_CASE("propel: the machine moves along its heading as the curve says, and th
     }
     CHECK_THROWS_WITH(default_loading_cycle(g, dipper, -1.0), Catch::Contains("advance_per_pass_m = -1"));
 }
+
+TEST_CASE("a wall that does not block the machine leaves the shovel as if it were not there; one that does, stops it",
+          "[rigid][shovel][unit]")
+{
+    // the dipper holds a pose with a fixed box through its middle: let through, the drive forces equal
+    // those of the same pose without the box (to round-off); blocked, contact changes them
+    const meshes::Dipper dipper = meshes::make_dipper({});
+    const ShovelGeometry g;
+    const ShovelPose pose = pose_shovel(g, dipper, 30.0, 8.0);
+    const MotionCurves hold_pose = hold(pose.rope_length_m, 8.0);
+    const Vec3 centre = pose.dipper_origin_m + pose.dipper_rotation * Vec3{2.0, 0.0, 0.5};
+    const meshes::TriangleMesh box = meshes::make_box_mesh(centre - Vec3{0.3, 3.0, 0.3}, centre + Vec3{0.3, 3.0, 0.3});
+    const auto forces_after = [&](int walls) {  // 0: none, 1: let through, 2: blocking
+        RigidWorld w = shovel_world();
+        if (walls > 0) {
+            const BodyId id = w.add_static_mesh(box, w.material_index("steel"), "box");
+            if (walls == 1) w.set_blocks_machine(id, false);
+        }
+        w.add_rope_shovel(dipper, g, hold_pose, w.material_index("steel"));
+        for (int k = 0; k < 300; ++k) w.step();
+        return std::make_pair(w.shovel_reading().hoist_force_filtered_N, w.shovel_reading().crowd_force_filtered_N);
+    };
+    const auto free = forces_after(0), through = forces_after(1), blocked = forces_after(2);
+    CHECK(through.first == Approx(free.first).epsilon(1e-9));
+    CHECK(through.second == Approx(free.second).margin(1e-6 * std::abs(free.first)));
+    CHECK(std::abs(blocked.first - free.first) + std::abs(blocked.second - free.second) > 0.01 * free.first);
+    RigidWorld w = shovel_world();
+    const BodyId rock = w.add_rock(generate_rock({0.4, 1.0, 1.2, 20}, 3), 2700.0, w.material_index("rock"), {0, 0, 5});
+    CHECK_THROWS_WITH(w.set_blocks_machine(rock, false), Catch::Contains("is not fixed or kinematic"));
+}

@@ -130,7 +130,7 @@ TEST_CASE("every class of scenario error names file, line, column, key, value an
     e = error_of(std::regex_replace(small_scenario(), std::regex("duration_s: 0.3"), "duration_s: fast"));
     CHECK_THAT(e, Catch::Contains("case.yaml:6:15: time.duration_s: got \"fast\"; expected a finite number"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("normal: \\[0, 0, 1\\]"), "normal: [0, 1]"));
-    CHECK_THAT(e, Catch::Contains("case.yaml:8:47: planes[0].normal: got [0, 1]; expected a list of 3 numbers"));
+    CHECK_THAT(e, Catch::Contains("case.yaml:8:47: planes[0].normal: got [0, 1]; expected a list of 3 finite numbers"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("seed: 7"), "seed: 7.5"));
     CHECK_THAT(e, Catch::Contains("case.yaml:3:7: seed: got \"7.5\"; expected an integer"));
 
