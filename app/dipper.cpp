@@ -38,7 +38,7 @@ constexpr const char* kUsage =
     "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
     "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
     "       dipper calibrate repose FILE [--target DEG] [--tolerance DEG] [--pair A,B] [--rolling R1,R2,...]\n"
-    "                              [--out DIR] [--threads N] [--quiet]\n"
+    "                              [--seeds N] [--out DIR] [--threads N] [--quiet]\n"
     "       dipper report DIR      (report.md with figures, also written after run and resume)\n"
     "       dipper keys\n";
 
@@ -101,6 +101,12 @@ Options parse_options(int argc, char** argv, int first)
             o.repose.rolling_frictions.clear();
             for (std::size_t at = 0, comma; (comma = v.find(',', at)) != std::string::npos; at = comma + 1)
                 o.repose.rolling_frictions.push_back(number_option(arg, v.substr(at, comma - at)));
+        } else if (arg == "--seeds") {
+            const std::string v = value();
+            char* end = nullptr;
+            const long n = std::strtol(v.c_str(), &end, 10);
+            if (v.empty() || *end != '\0' || n < 1 || n > 100) usage("--seeds needs a whole number from 1 to 100; got '" + v + "'");
+            o.repose.seeds = static_cast<int>(n);
         } else if (arg == "--quiet") o.run.progress = false;
         else if (!arg.empty() && arg[0] == '-') usage("unknown option " + arg);
         else o.positional.push_back(arg);
@@ -279,7 +285,8 @@ int main(int argc, char** argv)
             std::printf("dipper calibrate repose: %zu runs, target %.4g +- %.4g deg\n", c.runs.size(), o.repose.target_deg,
                         o.repose.tolerance_deg);
             for (const ReposeRun& r : c.matches)
-                std::printf("  hit: friction %.4g, rolling friction %.4g -> %.2f deg\n", r.friction, r.rolling_friction, r.angle_deg);
+                std::printf("  hit: friction %.4g, rolling friction %.4g -> %.2f deg (sd %.2f deg over %d seeds)\n", r.friction,
+                            r.rolling_friction, r.angle_deg, r.angle_sd_deg, o.repose.seeds);
             for (const std::string& n : c.notes) std::printf("  %s\n", n.c_str());
             if (c.matches.size() > 1)
                 std::printf("  %zu pairs hit the target: the repose angle alone does not fix sliding and rolling friction\n", c.matches.size());

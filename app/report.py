@@ -17,7 +17,7 @@ def sweep_report(folder):
     columns = list(rows[0].keys()) if rows else []
     parameters = columns[1:columns.index("status")] if "status" in columns else []
     shown = parameters + [c for c in ("status", "pass1_mass_kg", "pass1_fill_factor", "pass1_mean_dig_force_N",
-                                      "wear_dipper_m3", "wear_dipper_bottom_m3", "wear_dipper_bars_m3", "mass_kg")
+                                      "pass1_mean_interface_force_N", "repose_angle_deg", "wear_dipper_m3", "wear_dipper_bottom_m3", "wear_dipper_bars_m3", "mass_kg")
                           if c in columns]
     lines = [f"# Sweep: {os.path.basename(os.path.abspath(folder))}", "", "| " + " | ".join(shown) + " |",
              "|" + " --- |" * len(shown)]
@@ -47,8 +47,11 @@ def sweep_report(folder):
             if categorical:
                 xs = list(range(len(labels)))
             quantities = [("pass1_mass_kg", "mass in the dipper, pass 1 [t]", 1e-3),
-                          ("pass1_mean_dig_force_N", "mean dig force, pass 1 [MN]", 1e-6)]
-            quantities = [q for q in quantities if q[0] in columns] or [("mass_kg", "mass [t]", 1e-3)]
+                          ("pass1_mean_dig_force_N", "mean dig force, pass 1 [MN]", 1e-6),
+                          ("pass1_mean_interface_force_N", "mean interface force, pass 1 [MN]", 1e-6)]
+            quantities = ([q for q in quantities if q[0] in columns] or
+                          ([("repose_angle_deg", "angle of repose [deg]", 1.0)] if "repose_angle_deg" in columns else []) or
+                          [("mass_kg", "mass [t]", 1e-3)])
             fig, axes = plt.subplots(1, len(quantities), figsize=(4.2 * len(quantities), 3.4), dpi=110)
             axes = axes if len(quantities) > 1 else [axes]
             for ax, (column, label, scale) in zip(axes, quantities):
@@ -120,9 +123,11 @@ try:
                [(c[:-len("_mass_kg")], [v / 1000.0 for v in series[c]]) for c in regions
                 if c != "bucket_mass_kg"])
         if "dig_force_N" in series:
-            figure("dig_force.png", "Drive forces of the shovel (moving average)", "force [MN]",
+            figure("dig_force.png", "Drive forces of the shovel (moving average) and the material's force on the dipper",
+                   "force [MN]",
                    [(label, [v / 1e6 for v in series[c]]) for label, c in
-                    (("dig force (eq. 11)", "dig_force_N"), ("hoist", "hoist_force_N"), ("crowd", "crowd_force_N"))])
+                    (("dig force (eq. 11)", "dig_force_N"), ("hoist", "hoist_force_N"), ("crowd", "crowd_force_N"),
+                     ("interface force on dipper and door", "interface_force_N")) if c in series])
             fig, ax = plt.subplots(figsize=(7, 3.6), dpi=110)
             ax.plot(t, [v / 1000.0 for v in series["bucket_mass_kg"]], linewidth=1.2, color="tab:blue")
             ax.set_xlabel("time [s]")
@@ -176,13 +181,18 @@ for wall, f in summary["wall_forces_N"].items():
 for region, m in summary["region_mass_kg"].items():
     lines.append(f"| mass in {region} | {g(m)} kg |")
 if "passes" in summary:
-    lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] |",
-              "| --- | --- | --- | --- | --- | --- |"]
+    lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] "
+              "| mean interface force over the dig [MN] | peak [MN] |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for p in summary["passes"]:
         lines.append(f"| {p['pass']} | {g(p.get('dig_start_s', p['start_s']))} to {g(p['dig_end_s'])} | {g(p['mass_kg'], 1e-3)} | "
-                     f"{g(p['fill_factor'])} | {g(p['mean_dig_force_N'], 1e-6)} | {g(p['peak_dig_force_N'], 1e-6)} |")
+                     f"{g(p['fill_factor'])} | {g(p['mean_dig_force_N'], 1e-6)} | {g(p['peak_dig_force_N'], 1e-6)} | "
+                     f"{g(p['mean_interface_force_N'], 1e-6) if 'mean_interface_force_N' in p else '–'} | "
+                     f"{g(p['peak_interface_force_N'], 1e-6) if 'peak_interface_force_N' in p else '–'} |")
     if not summary["passes"]:
-        lines.append("| (no dump yet) | | | | | |")
+        lines.append("| (no dump yet) | | | | | | | |")
+    lines += ["", "Dig force: sqrt(F_crowd² + F_hoist²) of the drives (thesis eq. 11). Interface force: the resultant of the "
+              "material's force on dipper and door (thesis Paper B Fig. 19)."]
 for part, w in summary.get("wear", {}).items():
     lines += ["", f"Wear of {part} ({w['law']}, constant {g(w['constant'])}): volume {g(w['volume_m3'])} m³, "
               f"deepest {g(w['max_depth_mm'])} mm."]

@@ -361,8 +361,9 @@ private:
 
 }  // namespace
 
-void load_state(CoupledWorld& world, const std::string& path)
+LoadedState load_state(CoupledWorld& world, const std::string& path, const KeepFilter& keep)
 {
+    LoadedState loaded;
     StateReader in(path);
     {
         auto s = in.line("the header");
@@ -394,7 +395,12 @@ void load_state(CoupledWorld& world, const std::string& path)
         p.angular_velocity_rad_per_s = in.vec(s, "angular velocity");
         p.radius_m = in.number(s, "radius");
         p.material = dem_material(in.read<std::string>(s, "material name"));
+        if (keep && !keep(p.position_m, p.radius_m)) {
+            ++loaded.spheres_left_out;
+            continue;
+        }
         dem.add_particle(p, concat(path, ", sphere ", k));
+        ++loaded.spheres;
     }
     std::size_t rocks = 0;
     {
@@ -438,10 +444,20 @@ void load_state(CoupledWorld& world, const std::string& path)
         }
         const rigid::ConvexPolyhedron shape =
             rigid::ConvexPolyhedron::from_mesh(meshes::TriangleMesh(std::move(vertices), std::move(triangles), concat(path, ", rock ", k)));
+        if (keep) {
+            double bound2 = 0.0;
+            for (const Vec3& x : shape.vertices_m()) bound2 = std::max(bound2, norm_squared(x - shape.centroid_m()));
+            if (!keep(position, std::sqrt(bound2))) {
+                ++loaded.rocks_left_out;
+                continue;
+            }
+        }
         world.add_rock(shape, density, rm, dm, position, rotation, v, w);
+        ++loaded.rocks;
     }
     auto s = in.line("'end'");
     if (in.read<std::string>(s, "'end'") != "end") in.fail("expected 'end'");
+    return loaded;
 }
 
 }  // namespace dipper::coupling

@@ -5,6 +5,7 @@
 #include "coupling/coupled_world.h"
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -59,8 +60,18 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo_m, const Vec3& hi
 void save_state(const CoupledWorld& world, const std::string& path,
                 double cut_above_m = std::numeric_limits<double>::infinity());
 
-/// Adds the spheres and rocks of a saved state to the worlds (materials matched by name). Errors name the
-/// file, the line and what was expected.
-void load_state(CoupledWorld& world, const std::string& path);
+/// Which bodies of a saved state load_state places: keep(centre, radius) for a sphere (its centre and
+/// radius) and for a rock (its centroid and the radius of the sphere about it that holds its hull).
+using KeepFilter = std::function<bool(const Vec3& centre_m, double radius_m)>;
+
+/// What load_state placed, and what the filter left out.
+struct LoadedState {
+    std::size_t spheres = 0, rocks = 0;
+    std::size_t spheres_left_out = 0, rocks_left_out = 0;
+};
+
+/// Adds the spheres and rocks of a saved state to the worlds (materials matched by name), those the filter
+/// keeps (all without one). Errors name the file, the line and what was expected.
+LoadedState load_state(CoupledWorld& world, const std::string& path, const KeepFilter& keep = {});
 
 }  // namespace dipper::coupling

@@ -18,19 +18,27 @@ namespace dipper::scenario {
 
 namespace fs = std::filesystem;
 
-ReposeCalibration search_repose(const std::function<double(double, double)>& angle_of, const ReposeSearch& s)
+ReposeCalibration search_repose(const std::function<double(double, double, int)>& angle_of, const ReposeSearch& s)
 {
     require_positive(s.tolerance_deg, "tolerance_deg", "repose calibration");
     require_in_range(s.target_deg, 1.0, 89.0, "target_deg", "repose calibration");
     if (!(s.friction_max > s.friction_min && s.friction_min >= 0.0))
         throw InputError(concat("repose calibration: friction range [", s.friction_min, ", ", s.friction_max, "] is empty"));
     if (s.max_runs_per_rolling < 2) throw InputError("repose calibration: at least 2 runs per rolling friction");
+    if (s.seeds < 1 || s.seeds > 100) throw InputError(concat("repose calibration: seeds per trial must be 1 to 100; got ", s.seeds));
     ReposeCalibration c;
     for (const double rolling : s.rolling_frictions) {
         const auto run = [&](double mu) {
-            const double a = angle_of(mu, rolling);
-            c.runs.push_back({mu, rolling, a});
-            return c.runs.back();
+            ReposeRun r{mu, rolling, 0.0, 0.0, {}};
+            for (int k = 0; k < s.seeds; ++k) r.seed_angles_deg.push_back(angle_of(mu, rolling, k));
+            for (const double a : r.seed_angles_deg) r.angle_deg += a / s.seeds;
+            if (s.seeds > 1) {
+                double sum2 = 0.0;
+                for (const double a : r.seed_angles_deg) sum2 += (a - r.angle_deg) * (a - r.angle_deg);
+                r.angle_sd_deg = std::sqrt(sum2 / (s.seeds - 1));
+            }
+            c.runs.push_back(r);
+            return r;
         };
         ReposeRun lo = run(s.friction_min), hi = run(s.friction_max);
         const double target = s.target_deg;
@@ -118,10 +126,13 @@ ReposeCalibration calibrate_repose(const std::string& file, const std::string& a
     trial.base_dir = fs::absolute(file).parent_path().string();
     const std::string key = concat("materials.pairs[", index, "].");
     int count = 0;
-    const auto angle_of = [&](double friction, double rolling) {
-        trial.parameters = {{key + "friction", {number(friction)}}, {key + "rolling_friction", {number(rolling)}}};
-        char name[32];
-        std::snprintf(name, sizeof name, "run_%03d", count++);
+    const auto angle_of = [&](double friction, double rolling, int seed_index) {
+        trial.parameters = {{key + "friction", {number(friction)}}, {key + "rolling_friction", {number(rolling)}},
+                            {"seed", {std::to_string(base.seed + static_cast<std::uint64_t>(seed_index))}}};
+        char name[48];
+        if (search.seeds == 1) std::snprintf(name, sizeof name, "run_%03d", count);
+        else std::snprintf(name, sizeof name, "run_%03d_seed_%d", count, seed_index);
+        if (seed_index + 1 == search.seeds) ++count;
         const std::string dir = (fs::path(out_dir) / name).string();
         RunOptions o = options;
         const RunResult r = run_scenario(trial.variant_scenario(0), dir, o);
@@ -134,26 +145,40 @@ ReposeCalibration calibrate_repose(const std::string& file, const std::string& a
             throw SimulationError(concat("repose calibration: the run in ", dir, " left no pile slope to fit (see its summary.json)"));
         const double angle = std::stod(m[1]);
         if (options.progress)
-            std::fprintf(stderr, "calibrate repose: friction %.4g, rolling friction %.4g: %.2f deg\n", friction, rolling, angle);
+            std::fprintf(stderr, "calibrate repose: friction %.4g, rolling friction %.4g, seed %llu: %.2f deg\n", friction, rolling,
+                         static_cast<unsigned long long>(base.seed + static_cast<std::uint64_t>(seed_index)), angle);
         return angle;
     };
     const ReposeCalibration c = search_repose(angle_of, search);
 
     const std::string csv_path = (fs::path(out_dir) / "calibration.csv").string();
     std::ofstream csv = open_for_writing(csv_path);
-    csv << "run,friction,rolling_friction,repose_angle_deg\n";
-    for (std::size_t k = 0; k < c.runs.size(); ++k)
-        csv << k << ',' << c.runs[k].friction << ',' << c.runs[k].rolling_friction << ',' << c.runs[k].angle_deg << '\n';
+    csv << "run,friction,rolling_friction,repose_angle_deg,angle_sd_deg,seed_angles_deg\n";
+    for (std::size_t k = 0; k < c.runs.size(); ++k) {
+        const ReposeRun& r = c.runs[k];
+        csv << k << ',' << r.friction << ',' << r.rolling_friction << ',' << r.angle_deg << ',' << r.angle_sd_deg << ',';
+        for (std::size_t q = 0; q < r.seed_angles_deg.size(); ++q) csv << (q ? ";" : "") << r.seed_angles_deg[q];
+        csv << '\n';
+    }
     finish_writing(csv, csv_path);
     const std::string md_path = (fs::path(out_dir) / "calibration.md").string();
     std::ofstream md = open_for_writing(md_path);
     md << "# Repose calibration of " << file << "\n\nTarget " << search.target_deg << " deg within " << search.tolerance_deg
-       << " deg, varying the " << a << "-" << b << " pair.\n\n| friction | rolling friction | angle [deg] |\n| --- | --- | --- |\n";
-    for (const ReposeRun& r : c.runs) md << "| " << number(r.friction) << " | " << number(r.rolling_friction) << " | " << number(r.angle_deg) << " |\n";
+       << " deg, varying the " << a << "-" << b << " pair";
+    if (search.seeds > 1)
+        md << "; each trial is the mean of " << search.seeds << " runs with seeds " << base.seed << " to " << base.seed + static_cast<std::uint64_t>(search.seeds - 1)
+           << " (sd: their standard deviation; the mean's standard error is sd / sqrt(" << search.seeds << "))";
+    md << ".\n\n| friction | rolling friction | angle [deg] | sd [deg] | each seed [deg] |\n| --- | --- | --- | --- | --- |\n";
+    for (const ReposeRun& r : c.runs) {
+        md << "| " << number(r.friction) << " | " << number(r.rolling_friction) << " | " << number(r.angle_deg) << " | " << number(r.angle_sd_deg) << " | ";
+        for (std::size_t q = 0; q < r.seed_angles_deg.size(); ++q) md << (q ? ", " : "") << number(r.seed_angles_deg[q]);
+        md << " |\n";
+    }
     md << "\n## Pairs that hit the target\n\n";
     if (c.matches.empty()) md << "None.\n";
     for (const ReposeRun& r : c.matches)
-        md << "- friction " << number(r.friction) << " with rolling friction " << number(r.rolling_friction) << ": " << number(r.angle_deg) << " deg\n";
+        md << "- friction " << number(r.friction) << " with rolling friction " << number(r.rolling_friction) << ": " << number(r.angle_deg)
+           << " deg" << (search.seeds > 1 ? concat(" (sd ", number(r.angle_sd_deg), " deg over ", search.seeds, " seeds)") : std::string()) << "\n";
     if (c.matches.size() > 1)
         md << "\nMore than one pair hits the target: sliding and rolling friction trade off against each other, so the repose "
               "angle alone does not fix both (the thesis' warning). Choose with a second measurement (flow rate, bulk density, "

@@ -14,7 +14,10 @@
 namespace dipper::scenario {
 
 struct ReposeRun {
-    double friction = 0.0, rolling_friction = 0.0, angle_deg = 0.0;
+    double friction = 0.0, rolling_friction = 0.0;
+    double angle_deg = 0.0;      ///< the mean over the trial's seeds
+    double angle_sd_deg = 0.0;   ///< sample standard deviation over the seeds (0 with one seed)
+    std::vector<double> seed_angles_deg;  ///< one per seed, in seed order
 };
 
 struct ReposeSearch {
@@ -22,6 +25,9 @@ struct ReposeSearch {
     std::vector<double> rolling_frictions{0.05, 0.1, 0.2};
     double friction_min = 0.2, friction_max = 1.2;
     int max_runs_per_rolling = 6;
+    /// Runs per trial, with the scenario's seed, seed + 1, ...: the trial's angle is their mean. One small
+    /// pile scatters by a few degrees from seed to seed, so a tolerance of 1 deg needs several.
+    int seeds = 1;
 };
 
 struct ReposeCalibration {
@@ -32,11 +38,13 @@ struct ReposeCalibration {
 
 /// The search itself, on any angle function (a run of the scenario, or a closed form in the tests): for
 /// each rolling friction, the angle at the ends of the friction range, then regula falsi on friction
-/// (the angle grows with friction) until within tolerance or out of runs.
-ReposeCalibration search_repose(const std::function<double(double friction, double rolling)>& angle_of, const ReposeSearch& search);
+/// (the angle grows with friction) until within tolerance or out of runs. angle_of(friction, rolling,
+/// k) is the angle of seed k; a trial calls it for k = 0 .. search.seeds - 1 and takes the mean.
+ReposeCalibration search_repose(const std::function<double(double friction, double rolling, int seed_index)>& angle_of,
+                                const ReposeSearch& search);
 
 /// Runs `scenario_file` (which must have probes.repose and a materials.pairs entry for the pair a-b) in
-/// out_dir/run_NNN for each trial and writes out_dir/calibration.csv and out_dir/calibration.md.
+/// out_dir/run_NNN for each trial (out_dir/run_NNN_seed_K with several seeds) and writes out_dir/calibration.csv and out_dir/calibration.md.
 ReposeCalibration calibrate_repose(const std::string& scenario_file, const std::string& material_a, const std::string& material_b,
                                    const ReposeSearch& search, const std::string& out_dir, const RunOptions& options);
 

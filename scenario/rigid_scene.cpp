@@ -247,6 +247,19 @@ bool inside_plate(const meshes::Plate& p, const Vec3& x)
 
 }  // namespace
 
+bool RigidScene::clear_of_machine(const Vec3& c, double r) const
+{
+    for (const int wall : {dipper_wall_, door_wall_}) {
+        if (wall < 0) continue;
+        const dem::MeshWall& m = dem_->mesh_wall(wall);
+        const Vec3 b = m.to_body(c);  // the mesh's own frame: bounding box first, then the surface
+        const Vec3 lo = m.mesh().bounds_min_m(), hi = m.mesh().bounds_max_m();
+        if (b.x < lo.x - r || b.y < lo.y - r || b.z < lo.z - r || b.x > hi.x + r || b.y > hi.y + r || b.z > hi.z + r) continue;
+        if (m.mesh().distance_m(b) < r) return false;
+    }
+    return true;
+}
+
 void RigidScene::check_tunnelling() const
 {
     if (!has_shovel() || coupled_->rocks().empty()) return;
@@ -310,6 +323,8 @@ void RigidScene::write_state(StateWriter& out) const
     out.value(dig_end_s_);
     out.value(dig_force_sum_);
     out.value(dig_force_peak_);
+    out.value(interface_force_sum_);
+    out.value(interface_force_peak_);
     out.value(dig_samples_);
 }
 
@@ -327,6 +342,8 @@ void RigidScene::read_state(StateReader& in)
     dig_end_s_ = in.value<double>();
     dig_force_sum_ = in.value<double>();
     dig_force_peak_ = in.value<double>();
+    interface_force_sum_ = in.value<double>();
+    interface_force_peak_ = in.value<double>();
     dig_samples_ = in.value<std::uint64_t>();
 }
 
@@ -365,6 +382,15 @@ BucketContents RigidScene::bucket() const
     return b;
 }
 
+Vec3 RigidScene::interface_force_N() const
+{
+    if (!has_shovel()) return {};
+    // spheres through the DEM walls, rocks through Bullet's contacts (the machine's own parts and the
+    // scenario's walls do not touch it there)
+    return dem_->wall_force_N(dipper_wall_) + dem_->wall_force_N(door_wall_) + rigid_->contact_force_N(dipper_body_) +
+           rigid_->contact_force_N(door_body_);
+}
+
 void RigidScene::track_passes()
 {
     if (!has_shovel()) return;
@@ -383,6 +409,9 @@ void RigidScene::track_passes()
     if (!door_open_ && digging) {
         dig_force_sum_ += r.dig_force_N;
         dig_force_peak_ = std::max(dig_force_peak_, r.dig_force_N);
+        const double interface = norm(interface_force_N());
+        interface_force_sum_ += interface;
+        interface_force_peak_ = std::max(interface_force_peak_, interface);
         if (dig_samples_++ == 0) dig_start_s_ = t;
         dig_end_s_ = t;
     }
@@ -398,12 +427,15 @@ void RigidScene::track_passes()
         pass.fill_factor = b.fill_factor;
         pass.mean_dig_force_N = dig_samples_ > 0 ? dig_force_sum_ / static_cast<double>(dig_samples_) : 0.0;
         pass.peak_dig_force_N = dig_force_peak_;
+        pass.mean_interface_force_N = dig_samples_ > 0 ? interface_force_sum_ / static_cast<double>(dig_samples_) : 0.0;
+        pass.peak_interface_force_N = interface_force_peak_;
         passes_.push_back(pass);
     }
     if (door_open_ && r.door_deg < 1.0) {
         door_open_ = false;
         pass_start_s_ = t;
         dig_force_sum_ = dig_force_peak_ = 0.0;
+        interface_force_sum_ = interface_force_peak_ = 0.0;
         dig_samples_ = 0;
         dig_start_s_ = dig_end_s_ = -1.0;
     }

@@ -29,6 +29,10 @@ struct PassRecord {
     double fill_factor = 0.0;        ///< that mass / (bulk density x struck volume)
     double mean_dig_force_N = 0.0;   ///< mean of sqrt(F_crowd^2 + F_hoist^2) over the dig phase (thesis eq. 11)
     double peak_dig_force_N = 0.0;
+    /// Mean and peak over the dig phase of the resultant force of the material on dipper and door (spheres
+    /// and rocks): the "resultant interface force" of thesis Paper B Fig. 19, which compares the wear bars.
+    double mean_interface_force_N = 0.0;
+    double peak_interface_force_N = 0.0;
 };
 
 /// What the dipper holds now.
@@ -81,6 +85,8 @@ public:
     bool has_shovel() const { return dipper_body_ >= 0; }
     const meshes::Dipper& dipper() const { return dipper_; }
     const rigid::ShovelReading& reading() const;
+    /// Resultant force of the spheres and rocks on dipper and door in the last step, N (0 without a shovel).
+    Vec3 interface_force_N() const;
     BucketContents bucket() const;
     const std::vector<PassRecord>& passes() const { return passes_; }
     /// Mass carried out of the dipper so far: the sum of the passes' masses, t.
@@ -94,6 +100,10 @@ public:
     /// Pose of a wear surface's mesh frame in the world now.
     void wear_pose(const SceneWear& w, Mat3& rotation, Vec3& origin_m) const;
 
+    /// Whether a sphere of radius r at c is clear of the dipper's and the door's surfaces in their present
+    /// pose (true without a shovel): a saved pile, built without the machine, loses what the dipper
+    /// occupies where a run starts (thesis Paper A §3.3 moved or removed those rocks by hand).
+    bool clear_of_machine(const Vec3& c, double r) const;
     /// The DEM walls that are machine parts or scenario walls (not rock hulls), for outputs.
     std::vector<int> listed_walls() const;
     bool is_rock_wall(int wall) const;
@@ -130,6 +140,7 @@ private:
     // pass tracking
     bool door_open_ = false;
     double pass_start_s_ = 0.0, dig_start_s_ = -1.0, dig_end_s_ = -1.0, dig_force_sum_ = 0.0, dig_force_peak_ = 0.0;
+    double interface_force_sum_ = 0.0, interface_force_peak_ = 0.0;
     std::uint64_t dig_samples_ = 0;
     // a built-in cycle's digs: [start + k period, start + k period + dig]; period 0: a motion file
     double cycle_start_s_ = 0.0, cycle_period_s_ = 0.0, cycle_dig_s_ = 0.0;

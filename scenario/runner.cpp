@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "dipper-checkpoint 1";
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 2";
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int signal) { g_signal = signal; }
@@ -115,7 +115,14 @@ public:
         }
         world_ = build_world(scenario_);
         if (scenario_.uses_coupling()) rigid_ = std::make_unique<RigidScene>(scenario_, *world_);
-        if (!scenario_.pile.empty()) coupling::load_state(rigid_->coupled(), scenario_.pile);  // errors name file and line
+        if (!scenario_.pile.empty()) {  // errors name file and line
+            const RigidScene& scene = *rigid_;
+            pile_ = coupling::load_state(rigid_->coupled(), scenario_.pile,
+                                         [&scene](const Vec3& c, double r) { return scene.clear_of_machine(c, r); });
+            if (options_.progress && (pile_.spheres_left_out > 0 || pile_.rocks_left_out > 0))
+                std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
+                             scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);
+        }
         build_particles(scenario_, *world_);
         if (rigid_) {
             rigid_->fill_mixed(scenario_);
@@ -155,6 +162,7 @@ public:
         snapshot_index_ = in.value<int>();
         wall_seconds_before_ = in.value<double>();
         steps_before_ = in.value<std::uint64_t>();
+        pile_ = in.value<coupling::LoadedState>();
         const auto csv_bytes = in.value<std::uint64_t>();
         walls_ = all_walls();
         const std::size_t series = 1 + walls_.size() + (rigid_ ? 1 + rigid_->wear().size() : 0);
@@ -301,8 +309,8 @@ private:
         if (rigid_) {
             csv_ << ",rocks,rock_kinetic_energy_J,rock_contacts";
             if (rigid_->has_shovel())
-                csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,swing_deg,door_deg,handle_angle_deg,"
-                        "crowd_extension_m,tooth_tip_x_m,tooth_tip_y_m,tooth_tip_z_m";
+                csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,interface_force_N,swing_deg,door_deg,"
+                        "handle_angle_deg,crowd_extension_m,tooth_tip_x_m,tooth_tip_y_m,tooth_tip_z_m";
             for (const SceneWear& w : rigid_->wear()) csv_ << ",wear_" << w.spec.part << "_m3";
         }
         csv_ << ",wall_s_per_step,wall_clock_s\n";
@@ -350,7 +358,7 @@ private:
                 const BucketContents b = rigid_->bucket();
                 const rigid::ShovelReading& r = rigid_->reading();
                 csv_ << ',' << b.mass_kg << ',' << b.fill_factor << ',' << r.crowd_force_filtered_N << ',' << r.hoist_force_filtered_N << ','
-                     << r.dig_force_filtered_N << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
+                     << r.dig_force_filtered_N << ',' << norm(rigid_->interface_force_N()) << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
                      << r.crowd_extension_m << ',' << r.tooth_tip_m.x << ',' << r.tooth_tip_m.y << ',' << r.tooth_tip_m.z;
             }
             for (const SceneWear& sw : rigid_->wear()) csv_ << ',' << sw.surface->total_volume_m3();
@@ -478,6 +486,7 @@ private:
         out.value(snapshot_index_);
         out.value(wall_seconds_now());
         out.value<std::uint64_t>(world_->step_count());
+        out.value(pile_);
         csv_.flush();
         out.value<std::uint64_t>(static_cast<std::uint64_t>(csv_.tellp()));
         const auto write_entries = [&](const dem::PvdCollection* c) {
@@ -553,6 +562,9 @@ private:
             out << (k ? ", " : "") << "\"" << json_escape(scenario_.regions[k].name) << "\": " << json_number(region_mass_kg(scenario_.regions[k]));
         out << "}";
         if (scenario_.repose) out << ",\n  \"repose_angle_deg\": " << json_number(repose_angle_deg());
+        if (!scenario_.pile.empty())
+            out << ",\n  \"pile\": {\"spheres\": " << pile_.spheres << ", \"rocks\": " << pile_.rocks << ", \"spheres_left_out\": "
+                << pile_.spheres_left_out << ", \"rocks_left_out\": " << pile_.rocks_left_out << "}";
         out << ",\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
@@ -576,7 +588,9 @@ private:
                     << ", \"dig_start_s\": " << json_number(p.dig_start_s) << ", \"dig_end_s\": " << json_number(p.dig_end_s) << ", \"dump_s\": " << json_number(p.dump_s)
                     << ", \"mass_kg\": " << json_number(p.mass_kg) << ", \"fill_factor\": " << json_number(p.fill_factor)
                     << ", \"mean_dig_force_N\": " << json_number(p.mean_dig_force_N)
-                    << ", \"peak_dig_force_N\": " << json_number(p.peak_dig_force_N) << "}";
+                    << ", \"peak_dig_force_N\": " << json_number(p.peak_dig_force_N)
+                    << ", \"mean_interface_force_N\": " << json_number(p.mean_interface_force_N)
+                    << ", \"peak_interface_force_N\": " << json_number(p.peak_interface_force_N) << "}";
             }
             out << (r.passes().empty() ? "]" : "\n  ]");
         }
@@ -657,6 +671,7 @@ private:
     int snapshot_index_ = 0;
     double wall_seconds_before_ = 0.0;
     std::uint64_t steps_before_ = 0, last_row_step_ = ~0ull, row_step_ = ~0ull;
+    coupling::LoadedState pile_;  ///< what the scenario's pile placed and left out
     double row_wall_s_ = 0.0;
     std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now(), last_progress_;
 };

@@ -275,8 +275,9 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
     // region masses, passes and wear as in the first variant's scenario
     const Scenario first = sweep.variant_scenario(0);
     for (const RegionProbe& r : first.regions) out << ',' << r.name << "_mass_kg";
+    if (first.repose) out << ",repose_angle_deg";
     for (std::size_t k = 1; k <= passes; ++k)
-        out << ",pass" << k << "_mass_kg,pass" << k << "_fill_factor,pass" << k << "_mean_dig_force_N";
+        out << ",pass" << k << "_mass_kg,pass" << k << "_fill_factor,pass" << k << "_mean_dig_force_N,pass" << k << "_mean_interface_force_N";
     if (first.shovel) out << ",tonnage_t";
     for (const WearSpec& w : first.wear) {
         out << ",wear_" << w.part << "_m3";
@@ -292,9 +293,11 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
         // names are looked up inside their own objects (a wall may carry a region's name)
         const std::string regions = s.substr(std::min(s.size(), s.find("\"region_mass_kg\"")));
         for (const RegionProbe& r : first.regions) out << ',' << json_field(regions, r.name);
+        if (first.repose) out << ',' << json_field(s, "repose_angle_deg");
         const std::vector<std::string> p = pass_objects(s);
         for (std::size_t k = 0; k < passes; ++k)
-            for (const char* key : {"mass_kg", "fill_factor", "mean_dig_force_N"}) out << ',' << (k < p.size() ? json_field(p[k], key) : "");
+            for (const char* key : {"mass_kg", "fill_factor", "mean_dig_force_N", "mean_interface_force_N"})
+                out << ',' << (k < p.size() ? json_field(p[k], key) : "");
         if (first.shovel) out << ',' << json_field(s, "tonnage_t");
         const std::string wear = s.substr(std::min(s.size(), s.find("\"wear\": {")));
         for (const WearSpec& w : first.wear) {

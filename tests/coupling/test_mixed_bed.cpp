@@ -87,6 +87,33 @@ TEST_CASE("a mixed bed follows Table 1's mass fractions, settles without overlap
         CHECK(a.velocity_m_per_s == b.velocity_m_per_s);
         CHECK(t->world.rocks()[k].shape.volume_m3() == Approx(s->world.rocks()[k].shape.volume_m3()).epsilon(1e-14));
     }
+    // A filter decides body by body: here whatever reaches above 0.4 m (the bed is about 0.55 m deep) stays out. A sphere reaches z + r, a rock
+    // its centroid's height plus the radius of the sphere about the centroid that holds its hull.
+    {
+        const auto below = [](const Vec3& c, double radius) { return c.z + radius <= 0.4; };
+        std::size_t spheres_below = 0, rocks_below = 0;
+        for (std::size_t i = 0; i < s->dem.particles().size(); ++i)
+            if (below(s->dem.particles().position_m[i], s->dem.particles().radius_m[i])) ++spheres_below;
+        for (const auto& rock : s->world.rocks()) {
+            double bound = 0.0;
+            for (const Vec3& v : rock.shape.vertices_m()) bound = std::max(bound, norm(v));
+            if (below(s->rigid.state(rock.body).position_m, bound)) ++rocks_below;
+        }
+        auto u = make_scene(5);
+        add_container(*u, 2.0, 3.0);
+        const coupling::LoadedState loaded = coupling::load_state(u->world, path, below);
+        CHECK(loaded.spheres == spheres_below);
+        CHECK(loaded.rocks == rocks_below);
+        CHECK(loaded.spheres + loaded.spheres_left_out == s->dem.particles().size());
+        CHECK(loaded.rocks + loaded.rocks_left_out == s->world.rocks().size());
+        CHECK(u->dem.particles().size() == spheres_below);
+        CHECK(u->world.rocks().size() == rocks_below);
+        CHECK(loaded.spheres_left_out > 0);  // the cut passes through the bed: both sides hold spheres
+        CHECK(loaded.spheres > 0);
+        for (std::size_t i = 0; i < u->dem.particles().size(); ++i)
+            CHECK(u->dem.particles().position_m[i].z + u->dem.particles().radius_m[i] <= 0.4);
+    }
+
     // The reloaded bed carries on as the original does: after a further 0.2 s of both, no rock is more than 5 mm
     // from its twin (the contact springs and Bullet's warm start begin afresh on reload; all else is exact).
     const double t0 = s->world.time_s();

@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 TEST_CASE("the repose search finds the sliding friction that hits the target for each rolling friction", "[scenario][calibrate]")
 {
     // a closed form that rises with both frictions: the pairs on the line 20 mu + 60 mu_r = 19.7 all hit 34.7
-    const auto linear = [](double mu, double mur) { return 15.0 + 20.0 * mu + 60.0 * mur; };
+    const auto linear = [](double mu, double mur, int) { return 15.0 + 20.0 * mu + 60.0 * mur; };
     ReposeSearch s;
     s.tolerance_deg = 0.2;
     const ReposeCalibration c = search_repose(linear, s);
@@ -32,7 +32,7 @@ TEST_CASE("the repose search finds the sliding friction that hits the target for
     CHECK(c.runs.size() == 9);
 
     // a saturating angle: converges within the run budget; a rolling friction too high cannot come down
-    const auto saturating = [](double mu, double mur) { return 45.0 * (1.0 - std::exp(-2.5 * mu)) + 80.0 * mur; };
+    const auto saturating = [](double mu, double mur, int) { return 45.0 * (1.0 - std::exp(-2.5 * mu)) + 80.0 * mur; };
     s.rolling_frictions = {0.05, 0.3};
     s.max_runs_per_rolling = 8;
     s.tolerance_deg = 0.5;
@@ -45,6 +45,35 @@ TEST_CASE("the repose search finds the sliding friction that hits the target for
 
     s.friction_max = s.friction_min;
     CHECK_THROWS_WITH(search_repose(saturating, s), Catch::Contains("friction range"));
+    s.friction_max = 1.2;
+    s.seeds = 0;
+    CHECK_THROWS_WITH(search_repose(saturating, s), Catch::Contains("seeds per trial must be 1 to 100; got 0"));
+}
+
+TEST_CASE("the repose search averages seeds: scatter that defeats single runs cancels in the mean", "[scenario][calibrate]")
+{
+    // the linear law of the test above with a seed-to-seed scatter of +-3 deg, as small piles show: seed 0 reads
+    // 3 deg high, seed 1 3 deg low, so each single run misses a 1 deg tolerance and the mean of the two is exact
+    const auto scattered = [](double mu, double mur, int seed) { return 15.0 + 20.0 * mu + 60.0 * mur + (seed % 2 == 0 ? 3.0 : -3.0); };
+    ReposeSearch s;
+    s.rolling_frictions = {0.1};
+    s.tolerance_deg = 1.0;
+    s.max_runs_per_rolling = 4;
+    const ReposeCalibration one = search_repose(scattered, s);  // seed 0 only: the search hits a line 3 deg off
+    REQUIRE(one.matches.size() == 1);
+    const double true_angle_one = 15.0 + 20.0 * one.matches[0].friction + 6.0;
+    CHECK(std::abs(true_angle_one - 34.7) == Approx(3.0).margin(1.0));  // 2 to 4 deg off the target in truth
+
+    s.seeds = 2;
+    const ReposeCalibration two = search_repose(scattered, s);
+    REQUIRE(two.matches.size() == 1);
+    const ReposeRun& hit = two.matches[0];
+    CHECK(hit.friction == Approx((34.7 - 21.0) / 20.0).margin(1.0 / 20.0));
+    REQUIRE(hit.seed_angles_deg.size() == 2);
+    CHECK(hit.seed_angles_deg[0] - hit.seed_angles_deg[1] == Approx(6.0));
+    CHECK(hit.angle_deg == Approx(0.5 * (hit.seed_angles_deg[0] + hit.seed_angles_deg[1])));
+    CHECK(hit.angle_sd_deg == Approx(std::sqrt(18.0)));  // sample sd of +-3: sqrt((9 + 9) / (2 - 1))
+    CHECK(two.runs.size() == 3);  // both ends and one regula falsi step, each of two seeds
 }
 
 TEST_CASE("dipper's repose calibration runs the scenario and writes its table", "[scenario][calibrate]")
@@ -56,6 +85,7 @@ TEST_CASE("dipper's repose calibration runs the scenario and writes its table", 
     s.max_runs_per_rolling = 2;  // the two ends of the friction range only: 2 runs
     s.target_deg = 25.0;
     s.tolerance_deg = 30.0;      // any angle hits: this checks the plumbing, the search is checked above
+    s.seeds = 2;                 // each trial twice, with the file's seed 5 and 6
     RunOptions o;
     o.progress = false;
     o.threads = 1;
@@ -66,12 +96,17 @@ TEST_CASE("dipper's repose calibration runs the scenario and writes its table", 
     for (const ReposeRun& r : c.runs) {
         CHECK(r.angle_deg > 5.0);
         CHECK(r.angle_deg < 60.0);
+        REQUIRE(r.seed_angles_deg.size() == 2);
+        CHECK(r.seed_angles_deg[0] != r.seed_angles_deg[1]);  // two different random fills
+        CHECK(r.angle_sd_deg > 0.0);
     }
     CHECK(c.runs[0].friction == 0.2);
     CHECK(c.runs[1].friction == 1.2);
-    CHECK_THAT(test::read_text_file(dir + "/calibration.csv"), Catch::StartsWith("run,friction,rolling_friction,repose_angle_deg\n0,0.2,0.05,"));
-    CHECK(fs::exists(dir + "/run_000/summary.json"));
-    CHECK(fs::exists(dir + "/run_001/summary.json"));
+    CHECK_THAT(test::read_text_file(dir + "/calibration.csv"),
+               Catch::StartsWith("run,friction,rolling_friction,repose_angle_deg,angle_sd_deg,seed_angles_deg\n0,0.2,0.05,"));
+    for (const char* run : {"run_000_seed_0", "run_000_seed_1", "run_001_seed_0", "run_001_seed_1"})
+        CHECK(fs::exists(dir + "/" + run + "/summary.json"));
+    CHECK_THAT(test::read_text_file(dir + "/run_000_seed_1/scenario.yaml"), Catch::Contains("seed: 6"));
 
     CHECK_THROWS_WITH(calibrate_repose(std::string(DIPPER_SOURCE_DIR) + "/tests/data/scenarios/repose_small.yaml", "ore", "rock", s, dir, o),
                       Catch::Contains("materials.pairs has no entry for ore-rock"));

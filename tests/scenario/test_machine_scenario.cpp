@@ -41,6 +41,36 @@ fills:
 
 std::string error_of(const std::string& text) { return test::scenario_error(text); }
 
+/// A scenario whose shovel holds the dig-end pose (handle level, crowd 7.5 m), writing its motion file into
+/// `dir`: the door opens from door_open_s to 30 deg in 0.3 s (never if door_open_s <= 0). 2.5 t of `material`
+/// (a fill's sizes and rocks) fill a box 1.8 m across in the middle of the inside, in world coordinates (the
+/// dipper is tilted, so the box is kept well inside its 4 x 4 x 3 m).
+std::string held_in_dipper(const std::string& dir, double duration_s, double door_open_s, const std::string& material)
+{
+    const rigid::ShovelPose pose = rigid::pose_shovel(rigid::ShovelGeometry{}, meshes::make_dipper({}), 0.0, 7.5);
+    std::vector<rigid::MotionSample> samples{{0.0, pose.rope_length_m, 7.5, 0.0, 0.0}};
+    if (door_open_s > 0.0) {
+        samples.push_back({door_open_s, pose.rope_length_m, 7.5, 0.0, 0.0});
+        samples.push_back({door_open_s + 0.3, pose.rope_length_m, 7.5, 0.0, 30.0});
+    } else {
+        samples.push_back({duration_s, pose.rope_length_m, 7.5, 0.0, 0.0});
+    }
+    fs::create_directories(dir);
+    rigid::MotionCurves::from_samples(samples, "held").write_csv(dir + "/held.csv");
+    const Vec3 middle = pose.dipper_origin_m + pose.dipper_rotation * Vec3{2.0, 0.0, 1.5};
+    const Vec3 lo = middle - Vec3{0.9, 0.9, 0.9}, hi = middle + Vec3{0.9, 0.9, 0.9};
+    return concat(R"(dipper_scenario: 1
+threads: 1
+time: {duration_s: )", duration_s, R"(}
+planes:
+  - {name: ground, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+fills:
+  - {mass_kg: 2500, box: {min_m: [)", lo.x, ", ", lo.y, ", ", lo.z, "], max_m: [", hi.x, ", ", hi.y, ", ", hi.z, "]},\n     ",
+                  material, R"(}
+shovel: {motion: held.csv, element_size_m: 0.3}
+)");
+}
+
 }  // namespace
 
 TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the key", "[scenario][shovel]")
@@ -143,34 +173,74 @@ TEST_CASE("rocks and walls the rigid world cannot hold are refused with the wall
                                                Catch::Contains("rock, ground, bucket, truck, steel"));
 }
 
+TEST_CASE("a saved pile loaded where the shovel stands leaves out the spheres the dipper and door would cut",
+          "[scenario][shovel]")
+{
+    // a lattice of 150 mm spheres 0.5 m apart through the space the dipper takes at the start of the default
+    // cycle (x 13-17.5 m, |y| < 2.1 m, z 0.1-3.8 m), as a pile built without the machine would hold
+    const fs::path dir = fs::temp_directory_path() / "dipper_pile_at_shovel";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::size_t n = 0;
+    std::ostringstream spheres;
+    for (double x = 12.0; x < 18.6; x += 0.5)
+        for (double y = -2.5; y < 2.6; y += 0.5)
+            for (double z = 0.3; z < 4.4; z += 0.5, ++n) spheres << x << ' ' << y << ' ' << z << " 0 0 0 0 0 0 0.15 ore\n";
+    {
+        std::ofstream pile(dir / "pile.txt");
+        pile << "dipper-state 1\nspheres " << n << "\n" << spheres.str() << "rocks 0\nend\n";
+    }
+    const Scenario s = parse_scenario(R"(dipper_scenario: 1
+threads: 1
+time: {duration_s: 0.002}
+planes:
+  - {name: ground, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+pile: pile.txt
+shovel: {element_size_m: 0.3}
+output: {vtk_interval_s: 0}
+)", "pile_at_shovel.yaml", dir.string());
+
+    // loaded whole, spheres sit deep in the steel: the first step stops on the overlap
+    {
+        auto dem = build_world(s);
+        RigidScene scene(s, *dem);
+        const coupling::LoadedState all = coupling::load_state(scene.coupled(), s.pile);
+        REQUIRE(all.spheres == n);
+        CHECK_THROWS_WITH(scene.step(), Catch::Contains("overlaps wall"));
+    }
+    // loaded as a run loads it, those spheres stay out and the first step finds no contact at all (the
+    // ground is 0.15 m below the lowest sphere)
+    std::size_t left_out = 0;
+    {
+        auto dem = build_world(s);
+        RigidScene scene(s, *dem);
+        const coupling::LoadedState kept =
+            coupling::load_state(scene.coupled(), s.pile, [&scene](const Vec3& c, double r) { return scene.clear_of_machine(c, r); });
+        left_out = kept.spheres_left_out;
+        CHECK(kept.spheres + kept.spheres_left_out == n);
+        CHECK(left_out > 20);       // the dipper's plates pass through the lattice
+        CHECK(kept.spheres > n / 2);  // most of it is clear of the steel, inside the dipper or around it
+        CHECK(dem->particles().size() == kept.spheres);
+        scene.step();
+        CHECK(dem->wall_contact_count() == 0);
+    }
+    // a run says what it left out
+    RunOptions o;
+    o.progress = false;
+    REQUIRE(run_scenario(s, (dir / "out").string(), o).status == RunStatus::completed);
+    CHECK_THAT(test::read_text_file((dir / "out" / "summary.json").string()),
+               Catch::Contains(concat("\"pile\": {\"spheres\": ", n - left_out, ", \"rocks\": 0, \"spheres_left_out\": ", left_out,
+                                      ", \"rocks_left_out\": 0}")));
+    fs::remove_all(dir);
+}
+
 TEST_CASE("material held in the dipper: its weight on dipper and door, the mass and fill factor it shows, "
           "and the pass recorded when the door opens", "[scenario][shovel]")
 {
-    // a motion file that holds the dig-end pose (handle level, crowd 7.5 m) for 2 s, then opens the door
-    const rigid::ShovelGeometry g;
+    // the dig-end pose held for 2 s, then the door opens
     const meshes::Dipper dipper = meshes::make_dipper({});
-    const rigid::ShovelPose pose = rigid::pose_shovel(g, dipper, 0.0, 7.5);
     const std::string dir = (fs::temp_directory_path() / "dipper_held_material").string();
-    fs::create_directories(dir);
-    rigid::MotionCurves::from_samples({{0.0, pose.rope_length_m, 7.5, 0.0, 0.0},
-                                       {2.0, pose.rope_length_m, 7.5, 0.0, 0.0},
-                                       {2.3, pose.rope_length_m, 7.5, 0.0, 30.0}},
-                                      "held")
-        .write_csv(dir + "/held.csv");
-    // a box of material in the middle of the inside, in world coordinates (the dipper is tilted, so the
-    // box is kept well inside: 1.8 m across in a 4 x 4 x 3 m inside)
-    const Vec3 middle = pose.dipper_origin_m + pose.dipper_rotation * Vec3{2.0, 0.0, 1.5};
-    const Vec3 lo = middle - Vec3{0.9, 0.9, 0.9}, hi = middle + Vec3{0.9, 0.9, 0.9};
-    const std::string text = concat(R"(dipper_scenario: 1
-threads: 1
-time: {duration_s: 2.4}
-planes:
-  - {name: ground, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
-fills:
-  - {mass_kg: 2500, box: {min_m: [)", lo.x, ", ", lo.y, ", ", lo.z, "], max_m: [", hi.x, ", ", hi.y, ", ", hi.z, R"(]},
-     sizes: [{radius_m: 0.15, mass_fraction: 1}]}
-shovel: {motion: held.csv, element_size_m: 0.3}
-)");
+    const std::string text = held_in_dipper(dir, 2.4, 2.0, "sizes: [{radius_m: 0.15, mass_fraction: 1}]");
     const Scenario s = parse_scenario(text, "held.yaml", dir);
     auto dem = build_world(s);
     RigidScene scene(s, *dem);
@@ -181,11 +251,13 @@ shovel: {motion: held.csv, element_size_m: 0.3}
     // the load on dipper and door, averaged over 0.5 s: the dipper hangs on its ropes and bobs on their
     // stretch at about 4 Hz, so the instantaneous load swings about the weight by some 10 %
     double load_sum = 0.0;
+    Vec3 interface_sum;
     int load_samples = 0;
     while (scene.coupled().time_s() < 1.9) {
         scene.step();
         if (scene.coupled().time_s() < 1.4) continue;
         load_sum -= dem->wall_force_N(dipper_wall).z + dem->wall_force_N(door_wall).z;
+        interface_sum += scene.interface_force_N();
         ++load_samples;
     }
 
@@ -204,6 +276,11 @@ shovel: {motion: held.csv, element_size_m: 0.3}
     CHECK(ke < 0.01 * mass * 9.81 * 1.0);  // below 1 % of the bed's potential energy over 1 m
     const double down = load_sum / load_samples;
     CHECK(down == Approx(mass * 9.81).epsilon(0.03));
+    // the interface force (resultant of the material's force on dipper and door) is that weight too, and
+    // points down
+    const Vec3 interface = interface_sum * (1.0 / load_samples);
+    CHECK(norm(interface) == Approx(mass * 9.81).epsilon(0.03));
+    CHECK(-interface.z == Approx(norm(interface)).epsilon(0.01));
     UNSCOPED_INFO("held material: " << mass << " kg, load on dipper and door " << down / 9.81 << " kg, kinetic energy " << ke << " J");
     CHECK(dem->wall_force_N(0).z == Approx(0.0).margin(1e-9));  // nothing rests on the ground
 
@@ -217,6 +294,41 @@ shovel: {motion: held.csv, element_size_m: 0.3}
     CHECK(p.mass_kg == Approx(mass).epsilon(0.02));  // at 5 deg open, at most a few spheres have left
     CHECK(p.mean_dig_force_N == 0.0);                // the hoist never hauled in: no dig phase
     CHECK(scene.tonnage_t() == Approx(p.mass_kg / 1000.0));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("the interface force of spheres and rocks held in the dipper is their weight", "[scenario][shovel]")
+{
+    // the held pose of the test above, with 30 % of the mass in 400 mm rocks: the rocks press on the dipper
+    // through Bullet's contacts, the spheres through the DEM walls; the resultant of both is the weight
+    const std::string dir = (fs::temp_directory_path() / "dipper_held_rocks").string();
+    const Scenario s = parse_scenario(
+        held_in_dipper(dir, 3.0, 0.0, "sizes: [{radius_m: 0.15, mass_fraction: 0.7}], rocks: [{size_m: 0.4, mass_fraction: 0.3}]"),
+        "held_rocks.yaml", dir);
+    auto dem = build_world(s);
+    RigidScene scene(s, *dem);
+    build_particles(s, *dem);
+    scene.fill_mixed(s);
+    REQUIRE(!scene.coupled().rocks().empty());
+    double mass = dem->total_mass_kg();
+    for (const coupling::RockRecord& r : scene.coupled().rocks()) mass += scene.rigid().mass_kg(r.body);
+    // averaged over 0.5 s after 1.4 s of settling, as above (the dipper bobs on its ropes): tolerance 3 %
+    Vec3 sum;
+    double spheres_only = 0.0;
+    int samples = 0;
+    const int dipper_wall = scene.listed_walls()[1], door_wall = scene.listed_walls()[2];
+    while (scene.coupled().time_s() < 1.9) {
+        scene.step();
+        if (scene.coupled().time_s() < 1.4) continue;
+        sum += scene.interface_force_N();
+        spheres_only += norm(dem->wall_force_N(dipper_wall) + dem->wall_force_N(door_wall));
+        ++samples;
+    }
+    UNSCOPED_INFO("held spheres and " << scene.coupled().rocks().size() << " rocks: " << mass << " kg, interface force "
+                                      << norm(sum) / samples / 9.81 << " kg-force, of the spheres alone " << spheres_only / samples / 9.81);
+    CHECK(spheres_only / samples < 0.9 * mass * 9.81);  // the rocks rest on the steel too, not only on spheres
+    CHECK(norm(sum) / samples == Approx(mass * 9.81).epsilon(0.03));
+    CHECK(-sum.z == Approx(norm(sum)).epsilon(0.01));   // and it points down
     fs::remove_all(dir);
 }
 
@@ -244,7 +356,7 @@ TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a
                                                     Catch::Contains("went through the steel") && Catch::Contains("Reduce time.step_s"));
 }
 
-TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and dig force, and the dipper's wear",
+TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and forces, the repose angle and the dipper's wear",
           "[scenario][shovel]")
 {
     const fs::path dir = fs::temp_directory_path() / "dipper_shovel_sweep_table";
@@ -253,7 +365,8 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and di
     fs::create_directories(dir / "variant_001");
     {
         std::ofstream scenario(dir / "base.yaml");
-        scenario << base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12}\n");
+        scenario << base("shovel: {}\nwear:\n  - {part: dipper, constant: 1.0e-12}\n"
+                         "probes:\n  repose: {min_m: [0, 0, 0], max_m: [1, 1, 1], along: x, bin_m: 0.1}\n");
         std::ofstream sweep(dir / "sweep.yaml");
         sweep << "dipper_sweep: 1\nbase: base.yaml\nparameters:\n  - {key: shovel.rake_angle_deg, values: [59.8, 63.8]}\n";
     }
@@ -261,13 +374,14 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and di
     const auto summary = [&](const fs::path& file, const std::string& passes, double wear) {
         std::ofstream out(file);
         out << "{\n  \"name\": \"x\",\n  \"status\": \"completed\",\n  \"time_s\": 60,\n  \"steps\": 10,\n  \"particles\": 5,\n"
-            << "  \"mass_kg\": 1000,\n  \"kinetic_energy_J\": 1,\n  \"region_mass_kg\": {},\n  \"state_hash\": \"ab\",\n"
+            << "  \"mass_kg\": 1000,\n  \"kinetic_energy_J\": 1,\n  \"region_mass_kg\": {},\n  \"repose_angle_deg\": " << 30.0 + wear
+            << ",\n  \"state_hash\": \"ab\",\n"
             << "  \"passes\": [" << passes << "\n  ],\n  \"tonnage_t\": 150,\n  \"wear\": {\"dipper\": {\"law\": \"force_work\", "
             << "\"constant\": 1e-12, \"volume_m3\": " << wear << ", \"max_depth_mm\": 0.1, \"volume_by_region_m3\": {\"bottom\": 0.25, "
             << "\"lip\": 0.125, \"sides\": 0, \"top\": 0, \"teeth\": 0, \"bars\": 0}}}\n}\n";
     };
     summary(dir / "variant_000" / "summary.json",
-            "\n    {\"pass\": 1, \"mass_kg\": 80000, \"fill_factor\": 1.0, \"mean_dig_force_N\": 4200000},"
+            "\n    {\"pass\": 1, \"mass_kg\": 80000, \"fill_factor\": 1.0, \"mean_dig_force_N\": 4200000, \"mean_interface_force_N\": 2100000},"
             "\n    {\"pass\": 2, \"mass_kg\": 70000, \"fill_factor\": 0.875, \"mean_dig_force_N\": 3900000}",
             0.5);
     summary(dir / "variant_001" / "summary.json", "\n    {\"pass\": 1, \"mass_kg\": 85000, \"fill_factor\": 1.0625, \"mean_dig_force_N\": 4300000}",
@@ -279,11 +393,12 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and di
     std::getline(in, header);
     std::getline(in, first);
     std::getline(in, second);
-    CHECK_THAT(header, Catch::EndsWith("pass1_mass_kg,pass1_fill_factor,pass1_mean_dig_force_N,pass2_mass_kg,pass2_fill_factor,"
-                                       "pass2_mean_dig_force_N,tonnage_t,wear_dipper_m3,wear_dipper_bottom_m3,wear_dipper_lip_m3,"
-                                       "wear_dipper_bars_m3"));
-    CHECK_THAT(first, Catch::StartsWith("0,\"59.8\",completed,") && Catch::EndsWith(",80000,1.0,4200000,70000,0.875,3900000,150,0.5,0.25,0.125,0"));
-    CHECK_THAT(second, Catch::StartsWith("1,\"63.8\",completed,") && Catch::EndsWith(",85000,1.0625,4300000,,,,150,0.75,0.25,0.125,0"));
+    CHECK_THAT(header, Catch::EndsWith("repose_angle_deg,pass1_mass_kg,pass1_fill_factor,pass1_mean_dig_force_N,pass1_mean_interface_force_N,"
+                                       "pass2_mass_kg,pass2_fill_factor,pass2_mean_dig_force_N,pass2_mean_interface_force_N,"
+                                       "tonnage_t,wear_dipper_m3,wear_dipper_bottom_m3,wear_dipper_lip_m3,wear_dipper_bars_m3"));
+    // a field a summary lacks (an older run's) stays empty
+    CHECK_THAT(first, Catch::StartsWith("0,\"59.8\",completed,") && Catch::EndsWith(",30.5,80000,1.0,4200000,2100000,70000,0.875,3900000,,150,0.5,0.25,0.125,0"));
+    CHECK_THAT(second, Catch::StartsWith("1,\"63.8\",completed,") && Catch::EndsWith(",30.75,85000,1.0625,4300000,,,,,,150,0.75,0.25,0.125,0"));
     fs::remove_all(dir);
 }
 
