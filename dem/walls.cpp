@@ -47,6 +47,15 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
         bound_centre_ = (lo + hi) * 0.5;
         for (const Vec3& x : v) bound_radius_m_ = std::max(bound_radius_m_, norm(x - bound_centre_));
     }
+    // convex: every vertex on or behind every face plane, to round-off (most non-convex meshes fail at once)
+    convex_slack_m_ = 1e-9 * bound_radius_m_;
+    convex_ = !packed_body_.empty() && packed_body_.size() <= kMaxConvexCheckTriangles;
+    for (std::size_t t = 0; t < packed_body_.size() && convex_; ++t)
+        for (const Vec3& x : v)
+            if (dot(x - packed_body_[t].a, packed_body_[t].normal) > convex_slack_m_) {
+                convex_ = false;
+                break;
+            }
     if (motion_) {
         Mat3 r;
         Vec3 t;

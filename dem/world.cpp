@@ -765,6 +765,20 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         if (mc.mesh != body_mesh) {
             body_mesh = mc.mesh;
             xb = mw.to_body(x);
+            if (mw.convex()) {
+                // a convex body (a rock's hull) lies behind each face plane: a centre far enough in front of one
+                // of its candidate faces touches none of them, and one dot product per face tells
+                std::uint32_t end = k + 1;
+                while (end < last && candidates_[end].mesh == mc.mesh) ++end;
+                const double clear = r + mw.convex_slack_m();
+                bool separated = false;
+                for (std::uint32_t q = k; q < end && !separated; ++q)
+                    separated = dot(xb - candidate_triangles_[q].a, candidate_triangles_[q].normal) >= clear;
+                if (separated) {
+                    k = end - 1;
+                    continue;
+                }
+            }
         }
         const PackedTriangle& pt = candidate_triangles_[k];
         // a triangle whose plane is r or more away cannot be touched: one dot product spares the closest point

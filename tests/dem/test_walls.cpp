@@ -1,9 +1,12 @@
 // Triangle-mesh walls: one contact per touched feature, equivalence with planes, moving meshes, records.
 #include "dem/world.h"
 #include "helpers.h"
+#include "meshes/mesh_builder.h"
 #include "meshes/triangle_mesh.h"
 
 #include <catch2/catch.hpp>
+
+#include <random>
 
 using namespace dipper;
 using namespace dipper::dem;
@@ -212,4 +215,50 @@ TEST_CASE("a mesh moved from outside is seen by the neighbour lists", "[dem][wal
         w.step();
     }
     CHECK(w.particles().velocity_m_per_s[0].x == Approx(-2.0).epsilon(1e-3));
+}
+
+TEST_CASE("spheres around a convex mesh touch it exactly where their centre is within a radius of its surface",
+          "[dem][walls][unit]")
+{
+    // A convex mesh lets the search stop at the first candidate face whose plane the centre lies a radius in
+    // front of. 400 spheres of r = 50 mm at random places 30-80 mm from a box's surface (overlaps up to 0.4 r,
+    // below the 0.5 r the step refuses), none touching another,
+    // no gravity: after one step the contacts must be exactly those of the closest-point rule, measured here
+    // with the mesh's own distance function, and each touching sphere has exactly one (off edges and corners).
+    const meshes::TriangleMesh box = meshes::make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0});
+    const meshes::TriangleMesh container = meshes::make_open_box_mesh(1.0, 1.0, 1.0, 0.5);
+    CHECK(MeshWall(box, 1, "box").convex());
+    CHECK(MeshWall(meshes::make_plate_mesh(1.0, 1.0, 2, 2), 1, "plate").convex());  // flat: no vertex in front
+    CHECK_FALSE(MeshWall(container, 1, "container").convex());                      // open upwards, normals inwards
+
+    WorldSettings settings;
+    settings.gravity_m_per_s2 = {};
+    World w(test::two_material_table(kSticky, 3700.0, 45e9, 0.3), settings);
+    w.add_mesh(box, 1, "box");
+    const double r = 0.05;
+    std::mt19937_64 rng(12);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::vector<Vec3> placed;
+    std::size_t touching = 0;
+    while (placed.size() < 400) {
+        // a point on the surface of the box grown by d in [30, 80] mm: a random face, then a random spot on it
+        const double d = 0.03 + 0.05 * unit(rng);
+        const int face = static_cast<int>(6.0 * unit(rng)) % 6, axis = face / 2;
+        Vec3 p{-d + (1.0 + 2.0 * d) * unit(rng), -d + (1.0 + 2.0 * d) * unit(rng), -d + (1.0 + 2.0 * d) * unit(rng)};
+        (axis == 0 ? p.x : axis == 1 ? p.y : p.z) = face % 2 == 0 ? -d : 1.0 + d;
+        bool clear = true;
+        for (const Vec3& q : placed) clear = clear && norm(p - q) > 2.0 * r + 1e-3;
+        if (!clear) continue;
+        placed.push_back(p);
+        if (box.distance_m(p) < r) ++touching;
+        w.add_particle({p, {}, {}, r, 0});
+    }
+    REQUIRE(touching > 50);                 // both kinds are there in numbers
+    REQUIRE(touching < placed.size() - 50);
+    w.step();
+    CHECK(w.wall_contact_count() == touching);
+    std::vector<int> per_particle(placed.size(), 0);
+    for (const ContactRecord& c : w.last_contact_records()) ++per_particle[static_cast<std::size_t>(c.particle_index)];
+    for (std::size_t i = 0; i < placed.size(); ++i)
+        CHECK(per_particle[i] == (box.distance_m(w.particles().position_m[i]) < r ? 1 : 0));
 }
