@@ -5,6 +5,7 @@
 #include "dem/material.h"
 #include "meshes/triangle_mesh.h"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -39,8 +40,14 @@ struct PrescribedMotion {
 
 /// A triangle's vertices and unit normal in one place, in its mesh's body frame: the contact search
 /// copies them into each sphere's candidate list and tests the sphere in that frame.
+/// A triangle's corners and normal in one place, for the contact search.
 struct PackedTriangle {
     Vec3 a, b, c, normal;
+};
+
+/// The mesh's ids of a triangle's vertices and edges: a sphere touching an edge or vertex is matched by id.
+struct TriangleIds {
+    std::array<std::uint32_t, 3> vertices, edges;
 };
 
 /// A triangle mesh wall. The mesh is kept in its body frame; its world pose and velocity are set each
@@ -65,6 +72,7 @@ public:
     const std::vector<Vec3>& vertices_world_m() const;
     /// Triangle t in the body frame.
     const PackedTriangle& packed_body(std::size_t t) const { return packed_body_[t]; }
+    TriangleIds triangle_ids(std::size_t t) const { return {mesh_.triangles()[t], mesh_.triangle_edges(t)}; }
     Vec3 to_body(const Vec3& x_world_m) const { return rotation_transposed_ * (x_world_m - translation_); }
     Vec3 to_world(const Vec3& x_body_m) const { return rotation_ * x_body_m + translation_; }
     /// An upper bound on how far any vertex has moved from where the pose (rotation0, translation0) put it:

@@ -555,6 +555,7 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     candidate_start_.assign(n + 1, 0);
     candidates_.clear();
     candidate_triangles_.clear();
+    candidate_ids_.clear();
     if (walls_.empty() || n == 0) return;
     double r_max = 0.0;
     for (double r : particles_.radius_m) r_max = std::max(r_max, r);
@@ -643,9 +644,12 @@ void World::copy_candidate_triangles()
 {
     // each candidate's triangle beside it: the search streams through them instead of visiting the meshes
     candidate_triangles_.resize(candidates_.size());
+    candidate_ids_.resize(candidates_.size());
     for (std::size_t k = 0; k < candidates_.size(); ++k)
-        if (candidates_[k].triangle != kPlaneCandidate)
+        if (candidates_[k].triangle != kPlaneCandidate) {
             candidate_triangles_[k] = meshes_[candidates_[k].mesh].packed_body(candidates_[k].triangle);
+            candidate_ids_[k] = meshes_[candidates_[k].mesh].triangle_ids(candidates_[k].triangle);
+        }
 }
 
 // ---- forces --------------------------------------------------------------------------------------
@@ -751,7 +755,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         const std::size_t q = candidates_[k].mesh;
         const PlaneWall& pl = planes_[q];
         const double dist = dot(x, pl.normal) - plane_offset_m_[q];
-        if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, x - pl.normal * dist, pl.normal, r - dist, true});
+        if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, x - pl.normal * dist, pl.normal, r - dist, true, nullptr});
     }
 
     // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
@@ -786,14 +790,14 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         if (plane_distance >= r || plane_distance <= -r) continue;
         const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
         if (cp.distance_squared >= r * r) continue;
-        const auto& tri = mw.mesh().triangles()[mc.triangle];
         const double dist = std::sqrt(cp.distance_squared);
         const Vec3 point = mw.to_world(cp.point);
         Vec3 normal = mw.rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : pt.normal);
         std::uint32_t feature_id = mc.triangle;
-        if (cp.feature == meshes::Feature::Edge) feature_id = mw.mesh().triangle_edges(mc.triangle)[static_cast<std::size_t>(cp.local_index)];
-        if (cp.feature == meshes::Feature::Vertex) feature_id = tri[static_cast<std::size_t>(cp.local_index)];
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, point, normal, r - dist, true});
+        const TriangleIds& ids = candidate_ids_[k];
+        if (cp.feature == meshes::Feature::Edge) feature_id = ids.edges[static_cast<std::size_t>(cp.local_index)];
+        if (cp.feature == meshes::Feature::Vertex) feature_id = ids.vertices[static_cast<std::size_t>(cp.local_index)];
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, point, normal, r - dist, true, &ids});
     }
 
     // One contact per touched feature. A face hit always counts. An edge or vertex hit counts only if no
@@ -805,7 +809,6 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
     for (int a = first_mesh_hit; a < hit_count; ++a) {
         WallHit& h = hits[static_cast<std::size_t>(a)];
         if (h.feature == meshes::Feature::Face) continue;
-        const meshes::TriangleMesh& mesh = meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(h.wall)].index)].mesh();
         const double tolerance = 1e-9 * r;
         for (int b = first_mesh_hit; b < hit_count && h.keep; ++b) {
             const WallHit& o = hits[static_cast<std::size_t>(b)];
@@ -814,8 +817,8 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
                 if (b < a) h.keep = false;  // the same feature seen from another triangle: the first one stays
                 continue;
             }
-            const auto& tri = mesh.triangles()[static_cast<std::size_t>(o.triangle)];
-            const auto& edges = mesh.triangle_edges(static_cast<std::size_t>(o.triangle));
+            const auto& tri = o.ids->vertices;
+            const auto& edges = o.ids->edges;
             const bool shares = h.feature == meshes::Feature::Edge
                                     ? (edges[0] == h.feature_id || edges[1] == h.feature_id || edges[2] == h.feature_id)
                                     : (tri[0] == h.feature_id || tri[1] == h.feature_id || tri[2] == h.feature_id);

@@ -154,6 +154,7 @@ private:
         Vec3 point, normal;
         double overlap;
         bool keep;
+        const TriangleIds* ids;  ///< the triangle's vertex and edge ids beside its candidate (null for a plane)
     };
 
     void sum_wall_reactions();
@@ -210,6 +211,7 @@ private:
     std::vector<std::uint32_t> candidate_start_;
     std::vector<MeshCandidate> candidates_;
     std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside candidates_ (planes: unused)
+    std::vector<TriangleIds> candidate_ids_;           ///< beside candidates_, read only for touched triangles
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
