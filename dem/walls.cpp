@@ -67,6 +67,14 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
     }
 }
 
+bool MeshWall::sphere_clear(const Vec3& centre_world_m, double r) const
+{
+    const Vec3 b = to_body(centre_world_m);
+    const Vec3 lo = mesh_.bounds_min_m(), hi = mesh_.bounds_max_m();
+    if (b.x < lo.x - r || b.y < lo.y - r || b.z < lo.z - r || b.x > hi.x + r || b.y > hi.y + r || b.z > hi.z + r) return true;
+    return mesh_.distance_m(b) >= r;
+}
+
 void MeshWall::set_mass_kg(double mass_kg)
 {
     if (!(mass_kg >= 0.0) || !std::isfinite(mass_kg))

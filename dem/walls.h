@@ -75,6 +75,9 @@ public:
     TriangleIds triangle_ids(std::size_t t) const { return {mesh_.triangles()[t], mesh_.triangle_edges(t)}; }
     Vec3 to_body(const Vec3& x_world_m) const { return rotation_transposed_ * (x_world_m - translation_); }
     Vec3 to_world(const Vec3& x_body_m) const { return rotation_ * x_body_m + translation_; }
+    /// Whether a sphere (world centre, radius) is clear of the surface in its present pose: no point of the
+    /// mesh closer than the radius. A bounding-box test first, then the exact distance.
+    bool sphere_clear(const Vec3& centre_world_m, double radius_m) const;
     /// An upper bound on how far any vertex has moved from where the pose (rotation0, translation0) put it:
     /// |(R - R0) c + T - T0| + |R - R0|_2 rho, with c and rho a body-frame bounding sphere.
     double max_vertex_move_m(const Mat3& rotation0, const Vec3& translation0_m) const;

@@ -251,11 +251,7 @@ bool RigidScene::clear_of_machine(const Vec3& c, double r) const
 {
     for (const int wall : {dipper_wall_, door_wall_}) {
         if (wall < 0) continue;
-        const dem::MeshWall& m = dem_->mesh_wall(wall);
-        const Vec3 b = m.to_body(c);  // the mesh's own frame: bounding box first, then the surface
-        const Vec3 lo = m.mesh().bounds_min_m(), hi = m.mesh().bounds_max_m();
-        if (b.x < lo.x - r || b.y < lo.y - r || b.z < lo.z - r || b.x > hi.x + r || b.y > hi.y + r || b.z > hi.z + r) continue;
-        if (m.mesh().distance_m(b) < r) return false;
+        if (!dem_->mesh_wall(wall).sphere_clear(c, r)) return false;
     }
     return true;
 }

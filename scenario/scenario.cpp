@@ -731,12 +731,7 @@ public:
                 if (dot(c - p.point_m, p.normal) < r) return false;
                 continue;
             }
-            const dem::MeshWall& m = world_.mesh_wall(id);
-            // in the mesh's body frame (x_body = R^T (x - T)); a bounding-box test first
-            const Vec3 b = m.rotation().transposed() * (c - m.translation_m());
-            const Vec3 lo = m.mesh().bounds_min_m(), hi = m.mesh().bounds_max_m();
-            if (b.x < lo.x - r || b.y < lo.y - r || b.z < lo.z - r || b.x > hi.x + r || b.y > hi.y + r || b.z > hi.z + r) continue;
-            if (m.mesh().distance_m(b) < r) return false;
+            if (!world_.mesh_wall(id).sphere_clear(c, r)) return false;
         }
         return true;
     }
