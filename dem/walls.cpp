@@ -47,9 +47,17 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
         bound_centre_ = (lo + hi) * 0.5;
         for (const Vec3& x : v) bound_radius_m_ = std::max(bound_radius_m_, norm(x - bound_centre_));
     }
-    // convex: every vertex on or behind every face plane, to round-off (most non-convex meshes fail at once)
+    // a closed convex solid: every edge shared by exactly two triangles (an open plate or shell is a two-sided
+    // surface, not a solid), and every vertex on or behind every face plane, to round-off (most non-convex
+    // meshes fail at once)
     convex_slack_m_ = 1e-9 * bound_radius_m_;
     convex_ = !packed_body_.empty() && packed_body_.size() <= kMaxConvexCheckTriangles;
+    if (convex_) {
+        std::vector<std::uint8_t> uses(mesh_.edge_count(), 0);
+        for (std::size_t t = 0; t < packed_body_.size(); ++t)
+            for (std::uint32_t e : mesh_.triangle_edges(t)) uses[e] = static_cast<std::uint8_t>(std::min(uses[e] + 1, 3));
+        convex_ = std::all_of(uses.begin(), uses.end(), [](std::uint8_t u) { return u == 2; });
+    }
     for (std::size_t t = 0; t < packed_body_.size() && convex_; ++t)
         for (const Vec3& x : v)
             if (dot(x - packed_body_[t].a, packed_body_[t].normal) > convex_slack_m_) {

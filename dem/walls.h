@@ -100,10 +100,12 @@ public:
                       const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s,
                       std::uint64_t pose_version);
     const Vec3& reference_velocity_m_per_s() const { return reference_velocity_; }
-    /// True if no vertex lies in front of any triangle's plane by more than convex_slack_m() (a convex body
-    /// with outward normals, such as a rock's hull; checked for meshes of up to kMaxConvexCheckTriangles).
-    /// Such a body lies behind each of its face planes, so a sphere whose centre is r + convex_slack_m() or
-    /// more in front of any one of them touches none of its triangles.
+    /// True for a closed convex solid with outward normals, such as a rock's hull: every edge shared by two
+    /// triangles and no vertex in front of any triangle's plane by more than convex_slack_m() (checked for
+    /// meshes of up to kMaxConvexCheckTriangles). Such a body lies behind each of its face planes, so a
+    /// sphere whose centre is r + convex_slack_m() or more in front of any one of them touches none of its
+    /// triangles, and a centre outside it has its closest point on a face whose plane it is in front of.
+    /// An open plate or shell is not one: it is a two-sided surface.
     bool convex() const { return convex_; }
     double convex_slack_m() const { return convex_slack_m_; }
     static constexpr std::size_t kMaxConvexCheckTriangles = 2000;

@@ -619,15 +619,19 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
                 }
             std::uint32_t body_mesh = kPlaneCandidate;
             Vec3 pb;
+            double behind = range;
             for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1]; ++k) {
                 const MeshCandidate mc = bucket[k];
                 if (mc.mesh != body_mesh) {
                     body_mesh = mc.mesh;
                     pb = meshes_[mc.mesh].to_body(p);
+                    // A convex body's face that the centre lies more than the skin behind cannot come to face
+                    // it before the next rebuild, and only faces it faces can hold its contact (find_wall_contacts)
+                    behind = meshes_[mc.mesh].convex() ? skin_m_ : range;
                 }
                 const PackedTriangle& pt = meshes_[mc.mesh].packed_body(mc.triangle);
                 const double plane_distance = dot(pb - pt.a, pt.normal);
-                if (plane_distance >= range || plane_distance <= -range) continue;
+                if (plane_distance >= range || plane_distance <= -behind) continue;
                 if (meshes::closest_point_on_triangle(pb, pt.a, pt.b, pt.c).distance_squared < range * range) {
                     out.push_back(mc);
                     ++counts[i];
@@ -760,6 +764,17 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
 
     // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
     const int first_mesh_hit = static_cast<int>(hits.size());
+    auto push_triangle_hit = [&](std::uint32_t q, const MeshWall& mw, const Vec3& xb, const meshes::ClosestPoint& cp) {
+        const MeshCandidate mc = candidates_[q];
+        const double dist = std::sqrt(cp.distance_squared);
+        const Vec3 point = mw.to_world(cp.point);
+        const Vec3 normal = mw.rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : candidate_triangles_[q].normal);
+        std::uint32_t feature_id = mc.triangle;
+        const TriangleIds& ids = candidate_ids_[q];
+        if (cp.feature == meshes::Feature::Edge) feature_id = ids.edges[static_cast<std::size_t>(cp.local_index)];
+        if (cp.feature == meshes::Feature::Vertex) feature_id = ids.vertices[static_cast<std::size_t>(cp.local_index)];
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, point, normal, r - dist, true, &ids});
+    };
     // each mesh's triangles are tested in its body frame, with the sphere's centre moved there once per mesh
     std::uint32_t body_mesh = kPlaneCandidate;
     Vec3 xb;
@@ -770,18 +785,51 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
             body_mesh = mc.mesh;
             xb = mw.to_body(x);
             if (mw.convex()) {
-                // a convex body (a rock's hull) lies behind each face plane: a centre far enough in front of one
-                // of its candidate faces touches none of them, and one dot product per face tells
+                // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in
+                // front of one candidate face touches none of them. A centre in front of some face lies outside,
+                // and the hull's closest point then lies on a face it is in front of (the direction to it is in
+                // the normal cone there); a face whose interior holds its closest point holds the hull's.
+                // So one contact per body, from the faces it faces, without the per-triangle search below.
                 std::uint32_t end = k + 1;
                 while (end < last && candidates_[end].mesh == mc.mesh) ++end;
                 const double clear = r + mw.convex_slack_m();
+                double farthest = -std::numeric_limits<double>::infinity();
+                std::uint32_t farthest_q = k;
                 bool separated = false;
-                for (std::uint32_t q = k; q < end && !separated; ++q)
-                    separated = dot(xb - candidate_triangles_[q].a, candidate_triangles_[q].normal) >= clear;
-                if (separated) {
+                for (std::uint32_t q = k; q < end && !separated; ++q) {
+                    const double d = dot(xb - candidate_triangles_[q].a, candidate_triangles_[q].normal);
+                    separated = d >= clear;
+                    if (d > farthest) {
+                        farthest = d;
+                        farthest_q = q;
+                    }
+                }
+                if (!separated && farthest > 0.0) {
+                    // the face the centre is farthest in front of comes first: when the closest point of a
+                    // sphere on a face lies inside it, this is that face, and one query settles the body
+                    const PackedTriangle& ft = candidate_triangles_[farthest_q];
+                    meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
+                    std::uint32_t best = farthest_q;
+                    if (best_cp.feature != meshes::Feature::Face) {
+                        for (std::uint32_t q = k; q < end; ++q) {
+                            const PackedTriangle& pt = candidate_triangles_[q];
+                            const double d = dot(xb - pt.a, pt.normal);
+                            if (q == farthest_q || d <= 0.0 || d * d >= best_cp.distance_squared) continue;
+                            const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
+                            if (cp.distance_squared < best_cp.distance_squared) {
+                                best = q;
+                                best_cp = cp;
+                                if (cp.feature == meshes::Feature::Face) break;
+                            }
+                        }
+                    }
+                    if (best_cp.distance_squared < r * r) push_triangle_hit(best, mw, xb, best_cp);
+                }
+                if (separated || farthest > 0.0) {
                     k = end - 1;
                     continue;
                 }
+                // a centre behind every candidate face is inside the body: the per-triangle search below
             }
         }
         const PackedTriangle& pt = candidate_triangles_[k];
@@ -790,14 +838,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         if (plane_distance >= r || plane_distance <= -r) continue;
         const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
         if (cp.distance_squared >= r * r) continue;
-        const double dist = std::sqrt(cp.distance_squared);
-        const Vec3 point = mw.to_world(cp.point);
-        Vec3 normal = mw.rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : pt.normal);
-        std::uint32_t feature_id = mc.triangle;
-        const TriangleIds& ids = candidate_ids_[k];
-        if (cp.feature == meshes::Feature::Edge) feature_id = ids.edges[static_cast<std::size_t>(cp.local_index)];
-        if (cp.feature == meshes::Feature::Vertex) feature_id = ids.vertices[static_cast<std::size_t>(cp.local_index)];
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, point, normal, r - dist, true, &ids});
+        push_triangle_hit(k, mw, xb, cp);
     }
 
     // One contact per touched feature. A face hit always counts. An edge or vertex hit counts only if no

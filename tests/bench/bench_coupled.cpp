@@ -72,8 +72,19 @@ int main(int argc, char** argv)
     int spheres = 20000, rocks = 1000, threads = 1, steps = 400;
     double dt = 5e-5, settle_s = 0.6;
     std::string cache, substeps_list = "1,5,10,20";
-    for (int k = 1; k + 1 < argc; k += 2) {
+    const char* usage =
+        "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
+        "                            [--substeps 1,5,10,20] [--cache FILE]\n";
+    for (int k = 1; k < argc; k += 2) {
         const std::string key = argv[k];
+        if (key == "--help" || key == "-h") {
+            std::fputs(usage, stdout);
+            return 0;
+        }
+        if (k + 1 >= argc) {
+            std::fprintf(stderr, "option %s needs a value\n%s", argv[k], usage);
+            return 2;
+        }
         if (key == "--spheres") spheres = std::atoi(argv[k + 1]);
         else if (key == "--rocks") rocks = std::atoi(argv[k + 1]);
         else if (key == "--dt") dt = std::atof(argv[k + 1]);
@@ -83,7 +94,7 @@ int main(int argc, char** argv)
         else if (key == "--substeps") substeps_list = argv[k + 1];
         else if (key == "--cache") cache = argv[k + 1];
         else {
-            std::fprintf(stderr, "unknown option %s\n", argv[k]);
+            std::fprintf(stderr, "unknown option %s\n%s", argv[k], usage);
             return 2;
         }
     }

@@ -62,10 +62,11 @@ TEST_CASE("a mixed bed follows Table 1's mass fractions, settles without overlap
     CHECK(s->dem.wall_contact_count() == 0);
     // settle: the material falls to the floor and comes to rest. Translational and rock energy fall below 1e-3 of
     // the potential energy released (the bed's centre drops about 1 m). Spheres resting on a single contact may
-    // keep spinning about its normal (twisting is not resisted: docs/limits.md), so spin is left out.
-    while (s->world.time_s() < 2.0) s->world.step();
+    // keep spinning about its normal (twisting is not resisted: docs/limits.md), so spin is left out. A late
+    // rock toppling keeps 10-130 J moving until about 2.5 s (seen with other fill seeds too); by 3 s it is ~0.1 J.
+    while (s->world.time_s() < 3.0) s->world.step();
     const double moving_J = translational_J(s->dem) + s->rigid.kinetic_energy_J();
-    std::printf("mixed bed after 2 s: translational and rock energy %.3g J\n", moving_J);
+    std::printf("mixed bed after 3 s: translational and rock energy %.3g J\n", moving_J);
     CHECK(moving_J < 1e-3 * total * 9.81 * 1.0);
     for (const auto& rock : s->world.rocks()) CHECK(s->rigid.state(rock.body).position_m.z < 3.0);
 

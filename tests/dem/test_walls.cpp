@@ -228,8 +228,8 @@ TEST_CASE("spheres around a convex mesh touch it exactly where their centre is w
     const meshes::TriangleMesh box = meshes::make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0});
     const meshes::TriangleMesh container = meshes::make_open_box_mesh(1.0, 1.0, 1.0, 0.5);
     CHECK(MeshWall(box, 1, "box").convex());
-    CHECK(MeshWall(meshes::make_plate_mesh(1.0, 1.0, 2, 2), 1, "plate").convex());  // flat: no vertex in front
-    CHECK_FALSE(MeshWall(container, 1, "container").convex());                      // open upwards, normals inwards
+    CHECK_FALSE(MeshWall(meshes::make_plate_mesh(1.0, 1.0, 2, 2), 1, "plate").convex());  // open: two-sided
+    CHECK_FALSE(MeshWall(container, 1, "container").convex());                            // open upwards
 
     WorldSettings settings;
     settings.gravity_m_per_s2 = {};
@@ -258,7 +258,33 @@ TEST_CASE("spheres around a convex mesh touch it exactly where their centre is w
     w.step();
     CHECK(w.wall_contact_count() == touching);
     std::vector<int> per_particle(placed.size(), 0);
-    for (const ContactRecord& c : w.last_contact_records()) ++per_particle[static_cast<std::size_t>(c.particle_index)];
+    for (const ContactRecord& c : w.last_contact_records()) {
+        const auto i = static_cast<std::size_t>(c.particle_index);
+        ++per_particle[i];
+        // the one contact is at the closest point: its overlap is r minus the distance (to round-off of
+        // coordinates near 1 m) and its point lies on the surface, a radius minus the overlap from the centre
+        const Vec3 x = w.particles().position_m[i];
+        CHECK(c.overlap_m == Approx(r - box.distance_m(x)).margin(1e-12));
+        CHECK(box.distance_m(c.point_world) == Approx(0.0).margin(1e-12));
+        CHECK(norm(c.point_world - x) == Approx(r - c.overlap_m).margin(1e-12));
+    }
     for (std::size_t i = 0; i < placed.size(); ++i)
         CHECK(per_particle[i] == (box.distance_m(w.particles().position_m[i]) < r ? 1 : 0));
+}
+
+TEST_CASE("an open plate is touched from both sides", "[dem][walls][unit]")
+{
+    // An open surface is two-sided (a door or a pan is met from either side): a sphere resting 40 mm into a
+    // flat plate from above and one from below each get one contact, pushing them apart from the plate.
+    WorldSettings settings;
+    settings.gravity_m_per_s2 = {};
+    World w(test::two_material_table(kSticky, 3700.0, 45e9, 0.3), settings);
+    w.add_mesh(meshes::make_plate_mesh(1.0, 1.0, 4, 4), 1, "plate");  // z = 0, normal +z
+    const double r = 0.05;
+    w.add_particle({{0.3, 0.3, r - 0.004}, {}, {}, r, 0});
+    w.add_particle({{0.6, 0.6, -(r - 0.004)}, {}, {}, r, 0});
+    w.step();
+    REQUIRE(w.wall_contact_count() == 2);
+    CHECK(w.particles().velocity_m_per_s[0].z > 0.0);
+    CHECK(w.particles().velocity_m_per_s[1].z < 0.0);
 }
