@@ -5,6 +5,7 @@ import csv
 import json
 import os
 import sys
+import textwrap
 
 folder = sys.argv[1]
 
@@ -98,7 +99,7 @@ try:
             ax.plot(t, values, label=label, linewidth=1.2)
         ax.set_xlabel("time [s]")
         ax.set_ylabel(ylabel)
-        ax.set_title(title)
+        ax.set_title(textwrap.fill(title, 64), fontsize=10)  # long titles wrap instead of running off the figure
         if log:
             ax.set_yscale("log")
         ax.grid(True, alpha=0.3)

@@ -51,7 +51,8 @@ ShovelPose pose_shovel(const ShovelGeometry& geometry, const meshes::Dipper& dip
 /// from as steep as the ground allows, at most 75 deg below horizontal, to level), swing 90 deg to the truck while raising to the dump pose, 3 s
 /// dump with the door opening 60 deg, swing back high (the dipper's lowest point 8 m up) while closing
 /// the door, crowd drawn in and the dipper lowered to hang in front of the bank, crowd out into the toe:
-/// 46 s per pass, 138 s in all. With `advance_per_pass_m` > 0 the crawlers carry the machine that far forward while it swings
+/// 46 s per pass, 138 s in all. The key poses are joined by smooth curves (each drive accelerates and
+/// brakes; it rests where it turns back and at the dig's end), sampled every 0.05 s. With `advance_per_pass_m` > 0 the crawlers carry the machine that far forward while it swings
 /// back after each dump (28 s to 41 s of the pass), so that the next dig reaches the bank the last one
 /// cut back.
 MotionCurves default_loading_cycle(const ShovelGeometry& geometry, const meshes::Dipper& dipper, double advance_per_pass_m = 0.0);
