@@ -225,8 +225,20 @@ TEST_CASE("the built-in cycles move smoothly: every drive accelerates and brakes
         CHECK(swing < 12.0);
         CHECK(door < 360.0);
         CHECK(propel < 0.2);
+        // no overshoot: the swing stays within 0-90 deg and the door within 0-60 deg, and the hoist rope
+        // only shortens through each dig (the handle angle falls monotonically between its key poses)
+        const double period = cycle.duration_s() > 100.0 ? kDefaultCyclePass_s : kDigAndReturnPass_s;
+        for (std::size_t k = 0; k < s.size(); ++k) {
+            CHECK(s[k].swing_deg >= -1e-12);
+            CHECK(s[k].swing_deg <= 90.0 + 1e-12);
+            CHECK(s[k].door_deg >= -1e-12);
+            CHECK(s[k].door_deg <= 60.0 + 1e-12);
+            const double local = s[k].time_s - period * std::floor(s[k].time_s / period + 1e-9);
+            if (k > 0 && local > 1e-9 && local <= kBuiltInDig_s + 1e-9)
+                CHECK(s[k].hoist_length_m <= s[k - 1].hoist_length_m + 1e-12);
+        }
         for (int pass = 0; pass < 3; ++pass) {
-            const double end = pass * (cycle.duration_s() > 100.0 ? kDefaultCyclePass_s : kDigAndReturnPass_s) + kBuiltInDig_s;
+            const double end = pass * period + kBuiltInDig_s;
             const MotionSample a = cycle.at(end - 0.05), b = cycle.at(end), c = cycle.at(end + 0.05);
             // at rest at the dig's end: the hoist's speed on either side is what 4 m/s^2 allows in 0.05 s
             CHECK(std::abs(b.hoist_length_m - a.hoist_length_m) / 0.05 < 0.2);
