@@ -29,8 +29,18 @@ int main(int argc, char** argv)
     int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 4096;
     double settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
     std::vector<double> dts{1e-3};
-    for (int k = 1; k + 1 < argc; k += 2) {
+    const char* help = "usage: dipper_bench_rock_pile [--rocks N] [--dt S[,S...]] [--settle-s S] [--settle-dt S] [--steps N]\n"
+                        "                              [--point-count N] [--iterations N] [--pool N] [--margin-fraction F]\n";
+    for (int k = 1; k < argc; k += 2) {
         const std::string key = argv[k];
+        if (key == "--help" || key == "-h") {
+            std::fputs(help, stdout);
+            return 0;
+        }
+        if (k + 1 >= argc) {
+            std::fprintf(stderr, "option %s needs a value\n%s", argv[k], help);
+            return 2;
+        }
         if (key == "--rocks") rocks = std::atoi(argv[k + 1]);
         else if (key == "--dt") {
             dts.clear();
@@ -46,7 +56,7 @@ int main(int argc, char** argv)
         else if (key == "--pool") pool = std::atoi(argv[k + 1]);
         else if (key == "--margin-fraction") margin_fraction = std::atof(argv[k + 1]);
         else {
-            std::fprintf(stderr, "unknown option %s\n", argv[k]);
+            std::fprintf(stderr, "unknown option %s\n%s", argv[k], help);
             return 2;
         }
     }
