@@ -40,7 +40,6 @@ struct PrescribedMotion {
 
 /// A triangle's vertices and unit normal in one place, in its mesh's body frame: the contact search
 /// copies them into each sphere's candidate list and tests the sphere in that frame.
-/// A triangle's corners and normal in one place, for the contact search.
 struct PackedTriangle {
     Vec3 a, b, c, normal;
 };

@@ -154,9 +154,9 @@ double hermite(double t0, double t1, double y0, double y1, double m0, double m1,
 /// to a new speed: between linearly joined keys the dipper's sideways speed would jump by 3 m/s as the
 /// swing starts, an impulse on its load of tens of tonnes. Each handle angle is turned into the rope length
 /// that gives it after interpolation, so the rope follows the handle's smooth path. The dig ends at rest
-/// (key `dig_end_s` of each pass): the dig itself is then the same whatever follows it.
+/// (the key at kBuiltInDig_s of each pass): the dig itself is then the same whatever follows it.
 MotionCurves repeated(const ShovelGeometry& g, const meshes::Dipper& d, const std::vector<KeyPose>& pass, double period_s,
-                      int count, const std::string& name, double advance_per_pass_m = 0.0, double dig_end_s = kBuiltInDig_s)
+                      int count, const std::string& name, double advance_per_pass_m = 0.0)
 {
     std::vector<double> t, angle, crowd, swing, door, propel;
     std::vector<bool> rest;
@@ -168,7 +168,7 @@ MotionCurves repeated(const ShovelGeometry& g, const meshes::Dipper& d, const st
             swing.push_back(key.swing);
             door.push_back(key.door);
             propel.push_back(advance_per_pass_m * (k + key.propelled));
-            rest.push_back(key.t == dig_end_s);
+            rest.push_back(key.t == kBuiltInDig_s);
         }
     const std::vector<double> m_angle = monotone_slopes(t, angle, rest), m_crowd = monotone_slopes(t, crowd, rest),
                               m_swing = monotone_slopes(t, swing, rest), m_door = monotone_slopes(t, door, rest),

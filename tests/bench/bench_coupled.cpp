@@ -8,6 +8,7 @@
 #include "coupling/coupled_world.h"
 #include "coupling/mixed_bed.h"
 #include "meshes/mesh_builder.h"
+#include "tests/bench/options.h"
 
 #include <sys/resource.h>
 
@@ -75,29 +76,19 @@ int main(int argc, char** argv)
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
         "                            [--substeps 1,5,10,20] [--cache FILE]\n";
-    for (int k = 1; k < argc; k += 2) {
-        const std::string key = argv[k];
-        if (key == "--help" || key == "-h") {
-            std::fputs(usage, stdout);
-            return 0;
-        }
-        if (k + 1 >= argc) {
-            std::fprintf(stderr, "option %s needs a value\n%s", argv[k], usage);
-            return 2;
-        }
-        if (key == "--spheres") spheres = std::atoi(argv[k + 1]);
-        else if (key == "--rocks") rocks = std::atoi(argv[k + 1]);
-        else if (key == "--dt") dt = std::atof(argv[k + 1]);
-        else if (key == "--threads") threads = std::atoi(argv[k + 1]);
-        else if (key == "--steps") steps = std::atoi(argv[k + 1]);
-        else if (key == "--settle-s") settle_s = std::atof(argv[k + 1]);
-        else if (key == "--substeps") substeps_list = argv[k + 1];
-        else if (key == "--cache") cache = argv[k + 1];
-        else {
-            std::fprintf(stderr, "unknown option %s\n%s", argv[k], usage);
-            return 2;
-        }
-    }
+    const int status = bench::read_options(argc, argv, usage, [&](const std::string& key, const char* value) {
+        if (key == "--spheres") spheres = std::atoi(value);
+        else if (key == "--rocks") rocks = std::atoi(value);
+        else if (key == "--dt") dt = std::atof(value);
+        else if (key == "--threads") threads = std::atoi(value);
+        else if (key == "--steps") steps = std::atoi(value);
+        else if (key == "--settle-s") settle_s = std::atof(value);
+        else if (key == "--substeps") substeps_list = value;
+        else if (key == "--cache") cache = value;
+        else return false;
+        return true;
+    });
+    if (status >= 0) return status;
     std::vector<int> variants;
     {
         std::stringstream ss(substeps_list);

@@ -8,6 +8,7 @@
 // pile settles once.
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"
+#include "tests/bench/options.h"
 
 #include <sys/resource.h>
 
@@ -31,35 +32,25 @@ int main(int argc, char** argv)
     std::vector<double> dts{1e-3};
     const char* help = "usage: dipper_bench_rock_pile [--rocks N] [--dt S[,S...]] [--settle-s S] [--settle-dt S] [--steps N]\n"
                         "                              [--point-count N] [--iterations N] [--pool N] [--margin-fraction F]\n";
-    for (int k = 1; k < argc; k += 2) {
-        const std::string key = argv[k];
-        if (key == "--help" || key == "-h") {
-            std::fputs(help, stdout);
-            return 0;
-        }
-        if (k + 1 >= argc) {
-            std::fprintf(stderr, "option %s needs a value\n%s", argv[k], help);
-            return 2;
-        }
-        if (key == "--rocks") rocks = std::atoi(argv[k + 1]);
+    const int status = bench::read_options(argc, argv, help, [&](const std::string& key, const char* value) {
+        if (key == "--rocks") rocks = std::atoi(value);
         else if (key == "--dt") {
             dts.clear();
-            const std::string list = std::string(argv[k + 1]) + ",";
+            const std::string list = std::string(value) + ",";
             for (std::size_t at = 0, comma; (comma = list.find(',', at)) != std::string::npos; at = comma + 1)
                 dts.push_back(std::atof(list.substr(at, comma - at).c_str()));
         }
-        else if (key == "--settle-s") settle_s = std::atof(argv[k + 1]);
-        else if (key == "--settle-dt") settle_dt = std::atof(argv[k + 1]);
-        else if (key == "--steps") steps = std::atoi(argv[k + 1]);
-        else if (key == "--point-count") point_count = std::atoi(argv[k + 1]);
-        else if (key == "--iterations") iterations = std::atoi(argv[k + 1]);
-        else if (key == "--pool") pool = std::atoi(argv[k + 1]);
-        else if (key == "--margin-fraction") margin_fraction = std::atof(argv[k + 1]);
-        else {
-            std::fprintf(stderr, "unknown option %s\n%s", argv[k], help);
-            return 2;
-        }
-    }
+        else if (key == "--settle-s") settle_s = std::atof(value);
+        else if (key == "--settle-dt") settle_dt = std::atof(value);
+        else if (key == "--steps") steps = std::atoi(value);
+        else if (key == "--point-count") point_count = std::atoi(value);
+        else if (key == "--iterations") iterations = std::atoi(value);
+        else if (key == "--pool") pool = std::atoi(value);
+        else if (key == "--margin-fraction") margin_fraction = std::atof(value);
+        else return false;
+        return true;
+    });
+    if (status >= 0) return status;
     RigidSettings settings;
     settings.step_s = settle_dt;
     settings.solver_iterations = iterations;

@@ -237,6 +237,13 @@ TEST_CASE("the built-in cycles move smoothly: every drive accelerates and brakes
             if (k > 0 && local > 1e-9 && local <= kBuiltInDig_s + 1e-9)
                 CHECK(s[k].hoist_length_m <= s[k - 1].hoist_length_m + 1e-12);
         }
+        // between two resting keys the curve is the closed form y0 + (y1 - y0)(3u^2 - 2u^3): the swing of the
+        // default cycle from 0 deg at 15 s to 90 deg at 25 s (samples fall on u = 0.25 and 0.5)
+        if (period == kDefaultCyclePass_s)
+            for (int pass = 0; pass < 3; ++pass) {
+                CHECK(cycle.at(pass * period + 17.5).swing_deg == Approx(90.0 * (3.0 * 0.0625 - 2.0 * 0.015625)).margin(1e-9));
+                CHECK(cycle.at(pass * period + 20.0).swing_deg == Approx(45.0).margin(1e-9));
+            }
         for (int pass = 0; pass < 3; ++pass) {
             const double end = pass * period + kBuiltInDig_s;
             const MotionSample a = cycle.at(end - 0.05), b = cycle.at(end), c = cycle.at(end + 0.05);
