@@ -53,21 +53,30 @@ inline double rolling_stiffness(double kn_N_per_m, double rolling_friction, doub
     return 2.25 * kn_N_per_m * rolling_friction * rolling_friction * effective_radius_m * effective_radius_m;
 }
 
+/// The factor that keeps a history vector's length when it is projected into the tangent plane:
+/// (1 - q)^(-1/2), q = along^2 / |v|^2, along = v . n. A contact normal turns by a tiny angle in one step,
+/// so q is tiny and the series 1 + q/2 + 3q^2/8 is exact to round-off for q < 1e-5 (error 5q^3/16);
+/// larger turns take the closed form, and a vector along the normal (q >= 1) leaves nothing.
+/// Written with selects, not branches, so that a loop over contacts becomes SIMD code (see pair_batch.h).
+inline double tangent_plane_scale(double along, double length_squared)
+{
+    const double q = along * along / (length_squared > 0.0 ? length_squared : 1.0);
+    const double closed_form = 1.0 / std::sqrt(q < 1.0 ? 1.0 - q : 1.0);
+    return q < 1e-5 ? 1.0 + q * (0.5 + 0.375 * q) : (q >= 1.0 ? 0.0 : closed_form);
+}
+
 /// Re-expresses a history vector in the current tangent plane (normal n), keeping its length, so that a
 /// rotating contact carries its spring along instead of growing a normal component.
 inline Vec3 rotate_into_tangent_plane(const Vec3& v, const Vec3& n)
 {
-    const double old_len2 = norm_squared(v);
-    if (old_len2 == 0.0) return v;
     const double along = dot(v, n);
-    const Vec3 projected = v - n * along;
-    // length kept: scale = (1 - q)^(-1/2), q = along^2 / |v|^2. A contact normal turns by a tiny angle in
-    // one step, so q is tiny and the series 1 + q/2 + 3q^2/8 is exact to round-off for q < 1e-5
-    // (error 5q^3/16); larger turns take the closed form.
-    const double q = along * along / old_len2;
-    if (q < 1e-5) return projected * (1.0 + q * (0.5 + 0.375 * q));
-    if (q >= 1.0) return Vec3{};
-    return projected * (1.0 / std::sqrt(1.0 - q));
+    return (v - n * along) * tangent_plane_scale(along, norm_squared(v));
+}
+
+/// a where `pick` holds, else b, component by component (a select, not a branch)
+inline Vec3 select(bool pick, const Vec3& a, const Vec3& b)
+{
+    return {pick ? a.x : b.x, pick ? a.y : b.y, pick ? a.z : b.z};
 }
 
 /// Everything about a contact that does not change while the two bodies keep their sizes and materials:
@@ -108,6 +117,8 @@ inline ContactConstants contact_constants(double kn_N_per_m, double effective_ma
 /// Rolling (eq. 8): Mr -= k_r omega_roll dt, |Mr| <= mu_roll R* Fn; omega_roll is the relative angular
 /// velocity in the tangent plane (twisting is not resisted).
 /// Both springs are carried into the current tangent plane each step (rotate_into_tangent_plane).
+/// Written without branches (both sides of each limit are computed, then selected), so that the loop over
+/// a batch of contacts in pair_batch.cpp runs as SIMD code and gives the same bits as this scalar form.
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
@@ -125,27 +136,25 @@ inline ContactForces linear_spring_dashpot(double overlap_m, const Vec3& n, cons
     // tangential: history spring in the current tangent plane, dashpot, Coulomb limit
     const Vec3 vt = relative_velocity_m_per_s - n * vn;
     const double kt = k.tangential_stiffness_N_per_m, ct = k.tangential_damping_N_s_per_m;
-    h.tangential_spring_m = rotate_into_tangent_plane(h.tangential_spring_m, n) + vt * dt_s;
-    Vec3 ft = h.tangential_spring_m * (-kt) - vt * ct;
+    const Vec3 spring = rotate_into_tangent_plane(h.tangential_spring_m, n) + vt * dt_s;
+    const Vec3 ft = spring * (-kt) - vt * ct;
     const double ft2 = norm_squared(ft);
     const double limit = k.friction * out.normal_force_N;
-    if (ft2 > limit * limit) {
-        ft = ft2 > 0.0 ? ft * (limit / std::sqrt(ft2)) : Vec3{};
-        h.tangential_spring_m = (ft + vt * ct) * (-1.0 / kt);
-    }
-    out.tangential_force_N = ft;
+    const bool sliding = ft2 > limit * limit;  // then ft2 > 0
+    const Vec3 at_limit = ft * (limit / std::sqrt(ft2 > 0.0 ? ft2 : 1.0));
+    out.tangential_force_N = select(sliding, at_limit, ft);
+    h.tangential_spring_m = select(sliding, (at_limit + vt * ct) * (-1.0 / kt), spring);
 
-    // rolling: elastic-plastic spring on the relative rolling rotation
-    if (k.rolling_stiffness_N_m_per_rad > 0.0) {
-        const Vec3& w = relative_angular_velocity_rad_per_s;
-        const Vec3 w_roll = w - n * dot(w, n);
-        Vec3 mr = rotate_into_tangent_plane(h.rolling_torque_N_m, n) - w_roll * (k.rolling_stiffness_N_m_per_rad * dt_s);
-        const double mr2 = norm_squared(mr);
-        const double mr_limit = k.rolling_limit_m * out.normal_force_N;
-        if (mr2 > mr_limit * mr_limit) mr = mr2 > 0.0 ? mr * (mr_limit / std::sqrt(mr2)) : Vec3{};
-        h.rolling_torque_N_m = mr;
-        out.rolling_torque_N_m = mr;
-    }
+    // rolling: elastic-plastic spring on the relative rolling rotation (k_r = 0 and mu_roll R* = 0 when
+    // the pair has no rolling resistance: the torque stays zero)
+    const Vec3& w = relative_angular_velocity_rad_per_s;
+    const Vec3 w_roll = w - n * dot(w, n);
+    const Vec3 mr = rotate_into_tangent_plane(h.rolling_torque_N_m, n) - w_roll * (k.rolling_stiffness_N_m_per_rad * dt_s);
+    const double mr2 = norm_squared(mr);
+    const double mr_limit = k.rolling_limit_m * out.normal_force_N;
+    const Vec3 rolling = select(mr2 > mr_limit * mr_limit, mr * (mr_limit / std::sqrt(mr2 > 0.0 ? mr2 : 1.0)), mr);
+    h.rolling_torque_N_m = rolling;
+    out.rolling_torque_N_m = rolling;
     return out;
 }
 

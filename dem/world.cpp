@@ -1,6 +1,7 @@
 #include "dem/world.h"
 
 #include "core/errors.h"
+#include "dem/pair_batch.h"
 
 #include <algorithm>
 #include <chrono>
@@ -691,6 +692,23 @@ void World::compute_pair_forces(double dt_s)
         std::size_t begin, end;
         thread_block(pairs, t, threads_, begin, end);
         double local_max = 0.0;
+        PairBatch batch;  // the touching pairs, gathered for the SIMD law and scattered after it
+
+        // forces of the gathered pairs into the thread's arrays, springs back into the pair history
+        auto flush = [&]() {
+            local_max = std::max(local_max, evaluate_pair_batch(batch, dt_s));
+            for (int c = 0; c < batch.count; ++c) {
+                const std::uint32_t i = batch.i[c], j = batch.j[c];
+                const Vec3 fi{batch.fx[c], batch.fy[c], batch.fz[c]};
+                force[i] += fi;
+                force[j] -= fi;
+                torque[i] += Vec3{batch.tix[c], batch.tiy[c], batch.tiz[c]};
+                torque[j] += Vec3{batch.tjx[c], batch.tjy[c], batch.tjz[c]};
+                history[batch.pair[c]] = {{batch.sx[c], batch.sy[c], batch.sz[c]}, {batch.mx[c], batch.my[c], batch.mz[c]}};
+            }
+            batch.count = 0;
+        };
+
         ContactConstants memo;
         double memo_share_i = 0.5;
         double memo_ri = -1.0, memo_rj = -1.0, memo_mi = -1.0, memo_mj = -1.0;
@@ -708,11 +726,6 @@ void World::compute_pair_forces(double dt_s)
                 continue;
             }
             touching[k] = 1;
-            const double dist = std::sqrt(dist2);
-            const Vec3 nrm = dist > 0.0 ? d * (1.0 / dist) : Vec3{0.0, 0.0, 1.0};
-            const double overlap = rsum - dist;
-            const double r_min = std::min(r[i], r[j]);
-            if (overlap > local_max * r_min) local_max = overlap / r_min;
 
             // constants of the pair (eq. 4, 6, 8), recomputed only when the pair's kind changes: in a bed of
             // one size and material they are computed once per thread and step
@@ -722,22 +735,31 @@ void World::compute_pair_forces(double dt_s)
                 const PairCoefficients& p = table.pair_unchecked(mat[i], mat[j]);
                 memo = contact_constants(kr[i] * kr[j] / kr_sum * p.normal_stiffness_scale, m[i] * m[j] / m_sum,
                                          r[i] * r[j] / rsum, p);
+                // The two springs k1 r1 and k2 r2 in series share the overlap in proportion to their
+                // compliances: the contact point lies half-way for equal spheres and on the surface of a much
+                // stiffer body (the wall limit).
                 memo_share_i = kr[j] / kr_sum;
             }
-            // The two springs k1 r1 and k2 r2 in series share the overlap in proportion to their compliances:
-            // the contact point lies half-way for equal spheres and on the surface of a much stiffer body (the
-            // wall limit). Lever arms from each centre to that point:
-            const double deflection_i = memo_share_i * overlap;
-            const Vec3 arm_i = nrm * -(r[i] - deflection_i);
-            const Vec3 arm_j = nrm * (r[j] - (overlap - deflection_i));
-            const ContactForces f = linear_spring_dashpot(overlap, nrm, (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j)),
-                                                          w[i] - w[j], memo, history[k], dt_s);
-            const Vec3 fi = nrm * f.normal_force_N + f.tangential_force_N;
-            force[i] += fi;
-            force[j] -= fi;
-            torque[i] += cross(arm_i, fi) + f.rolling_torque_N_m;
-            torque[j] += cross(arm_j, -fi) - f.rolling_torque_N_m;
+            const int c = batch.count++;
+            batch.pair[c] = static_cast<std::uint32_t>(k);
+            batch.i[c] = i;
+            batch.j[c] = j;
+            batch.dx[c] = d.x; batch.dy[c] = d.y; batch.dz[c] = d.z;
+            batch.distance2[c] = dist2;
+            batch.ri[c] = r[i];
+            batch.rj[c] = r[j];
+            batch.share_i[c] = memo_share_i;
+            const Vec3 dv = v[i] - v[j];
+            batch.dvx[c] = dv.x; batch.dvy[c] = dv.y; batch.dvz[c] = dv.z;
+            batch.wix[c] = w[i].x; batch.wiy[c] = w[i].y; batch.wiz[c] = w[i].z;
+            batch.wjx[c] = w[j].x; batch.wjy[c] = w[j].y; batch.wjz[c] = w[j].z;
+            batch.set_constants(c, memo);
+            const ContactHistory& h = history[k];
+            batch.sx[c] = h.tangential_spring_m.x; batch.sy[c] = h.tangential_spring_m.y; batch.sz[c] = h.tangential_spring_m.z;
+            batch.mx[c] = h.rolling_torque_N_m.x; batch.my[c] = h.rolling_torque_N_m.y; batch.mz[c] = h.rolling_torque_N_m.z;
+            if (batch.count == PairBatch::kCapacity) flush();
         }
+        flush();
         max_ratio = std::max(max_ratio, local_max);
     }
     max_overlap_ratio_ = max_ratio;
