@@ -1,6 +1,8 @@
 // Cost of one evaluation of the contact law (Google Benchmark): a resting contact, a sliding contact,
-// and the same through the convenience overload that recomputes the pair constants.
+// the same through the convenience overload that recomputes the pair constants, and sphere pairs through
+// the batched (SIMD) form the pair loop uses, geometry and torques included.
 #include "dem/contact_law.h"
+#include "dem/pair_batch.h"
 
 #include <benchmark/benchmark.h>
 
@@ -77,8 +79,39 @@ void BM_RestingContactWithConstants(benchmark::State& state)
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(kContacts));
 }
 
+/// The same contacts as sphere pairs (0.1 m spheres) in batches of PairBatch::kCapacity.
+void run_batched(benchmark::State& state, bool slide)
+{
+    const Batch b = make_batch(slide);
+    const ContactConstants k = contact_constants(kKn, kMass, 0.05, kOre);
+    std::vector<PairBatch> batches(kContacts / PairBatch::kCapacity);
+    for (std::size_t c = 0; c < kContacts; ++c) {
+        PairBatch& p = batches[c / PairBatch::kCapacity];
+        const int lane = static_cast<int>(c % PairBatch::kCapacity);
+        p.count = lane + 1;
+        const Vec3 d = b.normal[c] * (0.2 - b.overlap[c]);
+        p.dx[lane] = d.x; p.dy[lane] = d.y; p.dz[lane] = d.z;
+        p.distance2[lane] = norm_squared(d);
+        p.ri[lane] = p.rj[lane] = 0.1;
+        p.share_i[lane] = 0.5;
+        p.dvx[lane] = b.velocity[c].x; p.dvy[lane] = b.velocity[c].y; p.dvz[lane] = b.velocity[c].z;
+        p.wix[lane] = b.spin[c].x; p.wiy[lane] = b.spin[c].y; p.wiz[lane] = b.spin[c].z;
+        p.wjx[lane] = p.wjy[lane] = p.wjz[lane] = 0.0;
+        p.set_constants(lane, k);
+        p.sx[lane] = p.sy[lane] = p.sz[lane] = p.mx[lane] = p.my[lane] = p.mz[lane] = 0.0;
+    }
+    for (auto _ : state)
+        for (PairBatch& p : batches) benchmark::DoNotOptimize(evaluate_pair_batch(p, 5e-5));
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(kContacts));
+}
+
+void BM_RestingPairBatched(benchmark::State& state) { run_batched(state, false); }
+void BM_SlidingPairBatched(benchmark::State& state) { run_batched(state, true); }
+
 }  // namespace
 
+BENCHMARK(BM_RestingPairBatched);
+BENCHMARK(BM_SlidingPairBatched);
 BENCHMARK(BM_RestingContact);
 BENCHMARK(BM_SlidingContact);
 BENCHMARK(BM_RestingContactNoRolling);
