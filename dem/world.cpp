@@ -351,6 +351,7 @@ void World::finish_step(double dt_s)
 
     // surface contact records for consumers (wear)
     records_.resize(wall_contacts_.size());
+#pragma omp parallel for schedule(static) num_threads(threads_)
     for (std::size_t k = 0; k < wall_contacts_.size(); ++k) {
         const WallContact& c = wall_contacts_[k];
         ContactRecord& r = records_[k];
@@ -957,12 +958,26 @@ void World::compute_wall_contacts(double dt_s)
         out.clear();
         if (any_wall)
             for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, hits, out);
+
+        // Last step's contacts have been read (their history): each thread's contacts, in particle order,
+        // replace them at the thread's offset, and each thread indexes its own particles.
+#pragma omp barrier
+#pragma omp single
+        {
+            wall_contact_offset_.assign(static_cast<std::size_t>(threads_) + 1, 0);
+            for (std::size_t q = 0; q < static_cast<std::size_t>(threads_); ++q)
+                wall_contact_offset_[q + 1] = wall_contact_offset_[q] + thread_wall_contacts_[q].size();
+            wall_contacts_.resize(wall_contact_offset_.back());
+            wall_contact_start_.resize(n + 1);
+            wall_contact_start_[n] = static_cast<std::uint32_t>(wall_contacts_.size());
+        }
+        std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
+        std::copy(out.begin(), out.end(), wall_contacts_.begin() + static_cast<std::ptrdiff_t>(k));
+        for (std::size_t i = begin; i < end; ++i) {
+            wall_contact_start_[i] = static_cast<std::uint32_t>(k);
+            while (k < wall_contact_offset_[static_cast<std::size_t>(t) + 1] && wall_contacts_[k].particle == i) ++k;
+        }
     }
-    wall_contacts_.clear();
-    for (const auto& v : thread_wall_contacts_) wall_contacts_.insert(wall_contacts_.end(), v.begin(), v.end());
-    wall_contact_start_.assign(n + 1, 0);
-    for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
-    std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
 }
 
 void World::gather_forces_and_kick(double half_kick_s)

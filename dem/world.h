@@ -208,6 +208,7 @@ private:
     // sphere-wall contacts of the last step, sorted by particle, and mesh triangle candidates
     std::vector<WallContact> wall_contacts_;
     std::vector<std::uint32_t> wall_contact_start_;
+    std::vector<std::size_t> wall_contact_offset_;  ///< per-thread offsets into wall_contacts_, this step
     std::vector<std::uint32_t> candidate_start_;
     std::vector<MeshCandidate> candidates_;
     std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside candidates_ (planes: unused)
