@@ -41,7 +41,41 @@ MotionCurves MotionCurves::from_samples(std::vector<MotionSample> samples, const
     MotionCurves m;
     m.samples_ = std::move(samples);
     m.source_ = source;
+    const std::size_t n = m.samples_.size();
+    std::vector<double> t(n);
+    for (std::size_t k = 0; k < n; ++k) t[k] = m.samples_[k].time_s;
+    m.slopes_.resize(n);
+    const auto fill = [&](double MotionSample::*field) {
+        std::vector<double> y(n);
+        for (std::size_t k = 0; k < n; ++k) y[k] = m.samples_[k].*field;
+        const std::vector<double> slope = monotone_slopes(t, y);
+        for (std::size_t k = 0; k < n; ++k) m.slopes_[k].*field = slope[k];
+    };
+    for (double MotionSample::*field : {&MotionSample::hoist_length_m, &MotionSample::crowd_extension_m, &MotionSample::swing_deg,
+                                        &MotionSample::door_deg, &MotionSample::propel_m})
+        fill(field);
     return m;
+}
+
+std::vector<double> monotone_slopes(const std::vector<double>& t, const std::vector<double>& y, const std::vector<bool>& rest)
+{
+    const std::size_t n = t.size();
+    std::vector<double> m(n, 0.0);
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+        const double h0 = t[k] - t[k - 1], h1 = t[k + 1] - t[k];
+        const double d0 = (y[k] - y[k - 1]) / h0, d1 = (y[k + 1] - y[k]) / h1;
+        if ((k < rest.size() && rest[k]) || d0 * d1 <= 0.0) continue;
+        const double w0 = 2.0 * h1 + h0, w1 = h1 + 2.0 * h0;
+        m[k] = (w0 + w1) / (w0 / d0 + w1 / d1);
+    }
+    return m;
+}
+
+double hermite(double t0, double t1, double y0, double y1, double m0, double m1, double t)
+{
+    // written from y0 so that a drive that stands (y1 = y0, slopes 0) keeps its value to the last bit
+    const double h = t1 - t0, u = (t - t0) / h, u2 = u * u, u3 = u2 * u;
+    return y0 + (y1 - y0) * (3.0 * u2 - 2.0 * u3) + h * (m0 * (u3 - 2.0 * u2 + u) + m1 * (u3 - u2));
 }
 
 MotionCurves MotionCurves::from_csv(const std::string& path)
@@ -95,12 +129,13 @@ MotionSample MotionCurves::at(double t) const
     if (t >= samples_.back().time_s) return samples_.back();
     const auto it = std::upper_bound(samples_.begin(), samples_.end(), t,
                                      [](double time, const MotionSample& s) { return time < s.time_s; });
-    const MotionSample& b = *it;
-    const MotionSample& a = *(it - 1);
-    const double u = (t - a.time_s) / (b.time_s - a.time_s);
-    const auto mix = [u](double x, double y) { return x + (y - x) * u; };
-    return {t, mix(a.hoist_length_m, b.hoist_length_m), mix(a.crowd_extension_m, b.crowd_extension_m),
-            mix(a.swing_deg, b.swing_deg), mix(a.door_deg, b.door_deg), mix(a.propel_m, b.propel_m)};
+    const std::size_t k = static_cast<std::size_t>(it - samples_.begin()) - 1;
+    const MotionSample &a = samples_[k], &b = samples_[k + 1], &ma = slopes_[k], &mb = slopes_[k + 1];
+    const auto curve = [&](double MotionSample::*field) {
+        return hermite(a.time_s, b.time_s, a.*field, b.*field, ma.*field, mb.*field, t);
+    };
+    return {t, curve(&MotionSample::hoist_length_m), curve(&MotionSample::crowd_extension_m), curve(&MotionSample::swing_deg),
+            curve(&MotionSample::door_deg), curve(&MotionSample::propel_m)};
 }
 
 void MotionCurves::write_csv(const std::string& path) const

@@ -1,5 +1,5 @@
 // Prescribed motion of the rope shovel: time curves of hoist rope length, crowd extension, swing angle
-// and door angle, read from CSV and interpolated linearly.
+// and door angle, read from CSV and joined by monotone cubic curves (continuous velocity, no overshoot).
 #pragma once
 
 #include <string>
@@ -25,7 +25,10 @@ public:
     static MotionCurves from_csv(const std::string& path);
     /// From samples already in memory; `source` names them in errors.
     static MotionCurves from_samples(std::vector<MotionSample> samples, const std::string& source);
-    /// Linear interpolation; before the first sample the first, after the last the last.
+    /// The curves at a time: between samples, each drive follows a monotone cubic through its samples
+    /// (monotone_slopes), so its velocity is continuous and it never passes beyond a sample's value; it is at
+    /// rest at the first and last samples and where it turns back or stands. Before the first sample the
+    /// first, after the last the last. Samples on a straight line give that line.
     MotionSample at(double time_s) const;
     double duration_s() const { return samples_.back().time_s; }
     const std::vector<MotionSample>& samples() const { return samples_; }
@@ -34,7 +37,17 @@ public:
 
 private:
     std::vector<MotionSample> samples_;
+    std::vector<MotionSample> slopes_;  ///< per sample, each drive's slope (per second); time_s unused
     std::string source_;
 };
+
+/// Slopes for a monotone cubic Hermite curve through (t_k, y_k) (Fritsch and Carlson's condition with the
+/// weighted harmonic mean of the neighbouring secants, as in PCHIP): the curve has a continuous velocity,
+/// never overshoots the values, and rests (zero slope) where it turns back or stands still, at the first
+/// and last points, and at the points marked in `rest` (empty: none).
+std::vector<double> monotone_slopes(const std::vector<double>& t, const std::vector<double>& y, const std::vector<bool>& rest = {});
+/// The cubic Hermite curve from (t0, y0) with slope m0 to (t1, y1) with slope m1, at t (exactly y0 at t0,
+/// and exactly y0 throughout when y1 = y0 and both slopes are 0).
+double hermite(double t0, double t1, double y0, double y1, double m0, double m1, double t);
 
 }  // namespace dipper::rigid

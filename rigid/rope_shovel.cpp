@@ -125,30 +125,6 @@ double toe_handle_angle_deg(const ShovelGeometry& g, const meshes::Dipper& d)
 /// of this pass's propel (0 to 1) the crawlers have done.
 struct KeyPose { double t, angle, crowd, swing, door, propelled = 0.0; };
 
-/// Slopes for a monotone cubic Hermite curve through (t_k, y_k) (Fritsch and Carlson's condition with
-/// the weighted harmonic mean of the neighbouring secants, as in PCHIP): the curve has a continuous
-/// velocity, never overshoots the key values, and rests (zero slope) at a key where the motion turns back
-/// or stands still, at the first and last keys, and at the keys marked in `rest`.
-std::vector<double> monotone_slopes(const std::vector<double>& t, const std::vector<double>& y, const std::vector<bool>& rest)
-{
-    const std::size_t n = t.size();
-    std::vector<double> m(n, 0.0);
-    for (std::size_t k = 1; k + 1 < n; ++k) {
-        const double h0 = t[k] - t[k - 1], h1 = t[k + 1] - t[k];
-        const double d0 = (y[k] - y[k - 1]) / h0, d1 = (y[k + 1] - y[k]) / h1;
-        if (rest[k] || d0 * d1 <= 0.0) continue;
-        const double w0 = 2.0 * h1 + h0, w1 = h1 + 2.0 * h0;
-        m[k] = (w0 + w1) / (w0 / d0 + w1 / d1);
-    }
-    return m;
-}
-
-double hermite(double t0, double t1, double y0, double y1, double m0, double m1, double t)
-{
-    const double h = t1 - t0, u = (t - t0) / h, u2 = u * u, u3 = u2 * u;
-    return (2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * h * m0 + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * h * m1;
-}
-
 /// The key poses of `count` passes joined by smooth curves, sampled every 0.05 s at most (and at every key
 /// pose exactly). A drive accelerates and brakes between key poses as a machine does instead of jumping
 /// to a new speed: between linearly joined keys the dipper's sideways speed would jump by 3 m/s as the

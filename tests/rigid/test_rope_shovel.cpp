@@ -306,12 +306,68 @@ TEST_CASE("the shovel follows its curves while digging through a rock pile", "[r
     CHECK(dipper_contacts > 0);  // it did dig through rocks
 }
 
+TEST_CASE("motion files are joined by monotone cubics: samples kept, velocity continuous, no overshoot, rest at turns",
+          "[rigid][shovel][unit]")
+{
+    // A coarse file of four samples 10 s apart: the crowd runs out at changing speed, the swing goes out and
+    // stands, the hoist pays in and then out again (it turns back at 20 s). Straight lines between the
+    // samples would change each drive's speed at once at every sample: the crowd by 0.25 m/s at 10 s.
+    const std::string text = "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg\n"
+                             "0,15,5,0,0\n10,12,8,45,0\n20,10,9,90,0\n30,12,9.5,90,0\n";
+    const MotionCurves m = MotionCurves::from_csv(temp_file("motion_coarse.csv", text));
+    const double times[4] = {0.0, 10.0, 20.0, 30.0};
+    const auto pick = [](const MotionSample& s, int drive) {
+        return drive == 0 ? s.hoist_length_m : drive == 1 ? s.crowd_extension_m : s.swing_deg;
+    };
+    const auto value = [&](double t, int drive) { return pick(m.at(t), drive); };
+    // one-sided speeds over 1e-5 s: their error is about 1e-5 s times the acceleration (below 0.1 per s^2
+    // here), so 1e-5 bounds a real jump; the jumps of straight lines would be 0.05 to 4.5 per second
+    const double h = 1e-5;
+    const auto left = [&](double t, int drive) { return (value(t, drive) - value(t - h, drive)) / h; };
+    const auto right = [&](double t, int drive) { return (value(t + h, drive) - value(t, drive)) / h; };
+    for (int drive = 0; drive < 3; ++drive) {
+        CAPTURE(drive);
+        for (int k = 0; k < 4; ++k) CHECK(value(times[k], drive) == pick(m.samples()[static_cast<std::size_t>(k)], drive));
+        for (int k = 1; k < 3; ++k) CHECK(std::abs(left(times[k], drive) - right(times[k], drive)) < 1e-5);
+        CHECK(std::abs(right(0.0, drive)) < 1e-5);  // starts from rest
+        CHECK(std::abs(left(30.0, drive)) < 1e-5);  // ends at rest
+        // between two samples the drive stays between their values (to round-off)
+        for (int k = 0; k < 3; ++k) {
+            const double lo = std::min(value(times[k], drive), value(times[k + 1], drive));
+            const double hi = std::max(value(times[k], drive), value(times[k + 1], drive));
+            for (int j = 1; j < 100; ++j) {
+                const double v = value(times[k] + 0.1 * j, drive);
+                CHECK(v >= lo - 1e-12);
+                CHECK(v <= hi + 1e-12);
+            }
+        }
+    }
+    CHECK(std::abs(left(20.0, 0)) < 1e-5);   // the hoist rests where it turns back
+    CHECK(std::abs(right(20.0, 0)) < 1e-5);
+    CHECK(std::abs(right(20.0, 2)) < 1e-5);  // the swing rests where it comes to stand
+    CHECK(right(10.0, 1) > 0.1);             // the crowd keeps moving through 10 s, at a continuous speed
+
+    // a drive that stands keeps its value to the last bit (the pass tracker reads a hauling hoist from it)
+    const MotionCurves stand = MotionCurves::from_samples({{0.0, 13.7, 7.5, 0.0, 0.0}, {2.0, 13.7, 7.5, 0.0, 0.0}, {2.3, 13.7, 7.5, 0.0, 30.0}}, "stand");
+    for (double t = 0.0; t < 2.3; t += 0.01) CHECK(stand.at(t).hoist_length_m == 13.7);
+
+    // interior samples on a straight line give the line between them
+    std::vector<MotionSample> line;
+    for (int k = 0; k < 6; ++k) line.push_back({double(k), 10.0 + 0.5 * k, 5.0 + 0.25 * k, 3.0 * k, 0.0, 0.1 * k});
+    const MotionCurves straight = MotionCurves::from_samples(line, "line");
+    for (double t = 1.0; t <= 4.0; t += 0.125) {
+        CHECK(straight.at(t).hoist_length_m == Approx(10.0 + 0.5 * t).epsilon(1e-14));
+        CHECK(straight.at(t).swing_deg == Approx(3.0 * t).epsilon(1e-14));
+        CHECK(straight.at(t).propel_m == Approx(0.1 * t).epsilon(1e-14));
+    }
+}
+
 TEST_CASE("motion files: unsorted times, missing columns and NaN are errors naming file, line and value",
           "[rigid][shovel][unit][bad_input]")
 {
     const std::string header = "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg\n";
     const auto ok = MotionCurves::from_csv(temp_file("motion_ok.csv", header + "0,15,8,0,0\n10,7,7.5,0,0\n"));
-    CHECK(ok.at(5.0).hoist_length_m == Approx(11.0));
+    CHECK(ok.at(5.0).hoist_length_m == Approx(11.0));  // half-way between two samples (the cubic is symmetric)
     CHECK(ok.at(-1.0).crowd_extension_m == 8.0);
     CHECK(ok.at(99.0).crowd_extension_m == 7.5);
     CHECK_THROWS_WITH(MotionCurves::from_csv(temp_file("motion_unsorted.csv", header + "0,15,8,0,0\n10,7,7.5,0,0\n5,9,8,0,0\n")),
