@@ -311,7 +311,7 @@ TEST_CASE("motion files are joined by monotone cubics: samples kept, velocity co
 {
     // A coarse file of four samples 10 s apart: the crowd runs out at changing speed, the swing goes out and
     // stands, the hoist pays in and then out again (it turns back at 20 s). Straight lines between the
-    // samples would change each drive's speed at once at every sample: the crowd by 0.25 m/s at 10 s.
+    // samples would change each drive's speed at once at a sample: the crowd by 0.2 m/s at 10 s.
     const std::string text = "time_s,hoist_length_m,crowd_extension_m,swing_deg,door_deg\n"
                              "0,15,5,0,0\n10,12,8,45,0\n20,10,9,90,0\n30,12,9.5,90,0\n";
     const MotionCurves m = MotionCurves::from_csv(temp_file("motion_coarse.csv", text));
@@ -321,7 +321,7 @@ TEST_CASE("motion files are joined by monotone cubics: samples kept, velocity co
     };
     const auto value = [&](double t, int drive) { return pick(m.at(t), drive); };
     // one-sided speeds over 1e-5 s: their error is about 1e-5 s times the acceleration (below 0.1 per s^2
-    // here), so 1e-5 bounds a real jump; the jumps of straight lines would be 0.05 to 4.5 per second
+    // here), so 1e-5 bounds a real jump; straight lines would jump by up to 4.5 per second (the swing at 20 s)
     const double h = 1e-5;
     const auto left = [&](double t, int drive) { return (value(t, drive) - value(t - h, drive)) / h; };
     const auto right = [&](double t, int drive) { return (value(t + h, drive) - value(t, drive)) / h; };
