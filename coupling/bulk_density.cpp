@@ -107,18 +107,31 @@ BulkDensityResult measure_bulk_density(const BulkDensityBox& box, double particl
     return r;
 }
 
-BulkDensityCalibration calibrate_bulk_density(const BulkDensityBox& box, double initial, double target)
+BulkDensityCalibration calibrate_bulk_density(const BulkDensityBox& box, double initial, double target, double tolerance,
+                                              int max_scalings)
 {
     require_positive(initial, "initial particle density", "bulk density calibration");
     require_positive(target, "target bulk density", "bulk density calibration");
+    require_positive(tolerance, "tolerance", "bulk density calibration");
+    if (max_scalings < 1)
+        throw InputError(concat("bulk density calibration: max_scalings is ", max_scalings, "; expected 1 or more"));
     BulkDensityCalibration c;
     const double solid = box.overfill * box.volume_m3() * target / initial;
     c.first = measure_bulk_density(box, initial, solid);
-    if (!(c.first.bulk_density_kg_per_m3 > 0.0))
-        throw SimulationError(concat("bulk density calibration: the box holds no material after settling (particle density ",
-                                     initial, " kg/m3); check the box and the fill"));
-    c.scaled_particle_density_kg_per_m3 = initial * target / c.first.bulk_density_kg_per_m3;
-    c.confirmed = measure_bulk_density(box, c.scaled_particle_density_kg_per_m3, solid);
+    BulkDensityResult last = c.first;
+    double density = initial;
+    while (c.scalings < max_scalings) {
+        if (!(last.bulk_density_kg_per_m3 > 0.0))
+            throw SimulationError(concat("bulk density calibration: the box holds no material after settling (particle density ",
+                                         density, " kg/m3); check the box and the fill"));
+        density *= target / last.bulk_density_kg_per_m3;
+        last = measure_bulk_density(box, density, solid);
+        ++c.scalings;
+        if (std::abs(last.bulk_density_kg_per_m3 / target - 1.0) <= tolerance) break;
+    }
+    c.scaled_particle_density_kg_per_m3 = density;
+    c.confirmed = last;
+    c.converged = std::abs(last.bulk_density_kg_per_m3 / target - 1.0) <= tolerance;
     return c;
 }
 

@@ -37,14 +37,20 @@ struct BulkDensityResult {
 BulkDensityResult measure_bulk_density(const BulkDensityBox& box, double particle_density_kg_per_m3, double solid_volume_m3);
 
 struct BulkDensityCalibration {
-    BulkDensityResult first, confirmed;
+    BulkDensityResult first;      ///< the weighing at the initial particle density
+    BulkDensityResult confirmed;  ///< the last weighing, at scaled_particle_density_kg_per_m3
     double scaled_particle_density_kg_per_m3 = 0.0;
+    int scalings = 0;             ///< weighings after the first
+    bool converged = false;       ///< the confirmed bulk density lies within the tolerance of the target
 };
 
 /// The thesis' calibration: weigh with `initial` particle density, scale it by target / measured bulk
-/// density, and weigh again to confirm. Both weighings pour the same solid volume with the same seed, so
-/// the bodies are the same and only their density differs.
+/// density, and weigh again to confirm. All weighings pour the same solid volume with the same seed, so
+/// the bodies are the same and only their density differs; the heavier or lighter bed settles a little
+/// differently, so when the confirmation misses the target by more than `tolerance` (a fraction), the
+/// density is scaled again by target / confirmed, up to `max_scalings` weighings after the first.
 BulkDensityCalibration calibrate_bulk_density(const BulkDensityBox& box, double initial_particle_density_kg_per_m3,
-                                              double target_bulk_density_kg_per_m3);
+                                              double target_bulk_density_kg_per_m3, double tolerance = 0.02,
+                                              int max_scalings = 3);
 
 }  // namespace dipper::coupling

@@ -160,15 +160,22 @@ TEST_CASE("mixed bed bad input: fractions, a box too small, corrupt state files"
 TEST_CASE("bulk density: scaling the particle density hits the target within 2 %", "[coupling][slow]")
 {
     // Thesis Paper A 3.1 on a box of half the sides (7 m3; the 28 m3 box is examples/bulk_density.cpp): weigh,
-    // scale the particle density by 1903 / measured, weigh again. The bodies are the same both times, so the
-    // bulk density moves with the particle density up to the settling of the heavier or lighter bed.
+    // scale the particle density by 1903 / measured, weigh again. The bodies are the same each time, so the
+    // bulk density moves with the particle density up to the settling of the heavier or lighter bed; in this
+    // small box with 850 mm rocks that settling moves the packing by up to about 2.5 %, so the calibration
+    // scales again while the confirmation misses by more than 2 %.
     coupling::BulkDensityBox box;
     box.length_m *= 0.5;
     box.width_m *= 0.5;
     box.settle_s = 2.0;
-    const coupling::BulkDensityCalibration c = coupling::calibrate_bulk_density(box, 3700.0, 1903.0);
-    std::printf("bulk density: %.1f kg/m3 at 3700, %.1f kg/m3 at the scaled %.1f kg/m3\n", c.first.bulk_density_kg_per_m3,
-                c.confirmed.bulk_density_kg_per_m3, c.scaled_particle_density_kg_per_m3);
+    const coupling::BulkDensityCalibration c = coupling::calibrate_bulk_density(box, 3700.0, 1903.0, 0.02, 3);
+    std::printf("bulk density: %.1f kg/m3 at 3700, %.1f kg/m3 at the scaled %.1f kg/m3 after %d scaling(s)\n",
+                c.first.bulk_density_kg_per_m3, c.confirmed.bulk_density_kg_per_m3, c.scaled_particle_density_kg_per_m3,
+                c.scalings);
     CHECK(c.first.bulk_density_kg_per_m3 > 1500.0);  // a filled box, not a sparse one
+    CHECK(c.converged);
     CHECK(c.confirmed.bulk_density_kg_per_m3 == Approx(1903.0).epsilon(0.02));
+    // the scaled density is the initial one times the product of target / measured over the weighings: the
+    // first scaling alone lands within the packing scatter of the target
+    CHECK(c.scaled_particle_density_kg_per_m3 == Approx(3700.0 * 1903.0 / c.first.bulk_density_kg_per_m3).epsilon(0.03));
 }
