@@ -508,6 +508,7 @@ void World::rebuild()
         pair_i_.insert(pair_i_.end(), thread_i[t].begin(), thread_i[t].end());
         pair_j_.insert(pair_j_.end(), thread_j[t].begin(), thread_j[t].end());
     }
+    ++pair_list_version_;
     const std::size_t pairs = pair_i_.size();
     pair_history_.assign(pairs, ContactHistory{});
     pair_touching_.assign(pairs, 0);
@@ -680,18 +681,37 @@ void World::compute_pair_forces(double dt_s)
     double max_ratio = 0.0;
     thread_force_N_.resize(static_cast<std::size_t>(threads_));
     thread_torque_N_m_.resize(static_cast<std::size_t>(threads_));
+    const bool ranges_stale = touched_ranges_version_ != pair_list_version_ || thread_touched_.size() != static_cast<std::size_t>(threads_);
+    thread_touched_.resize(static_cast<std::size_t>(threads_));
+    touched_ranges_version_ = pair_list_version_;
 
     // Each thread takes a fixed block of pairs and adds both particles' shares into its own arrays; the
     // gather adds the threads' arrays in thread order. Same thread count, same bits.
 #pragma omp parallel num_threads(threads_) reduction(max : max_ratio)
     {
         const int t = omp_get_thread_num();
-        thread_force_N_[static_cast<std::size_t>(t)].assign(n, Vec3{});
-        thread_torque_N_m_[static_cast<std::size_t>(t)].assign(n, Vec3{});
-        Vec3* __restrict force = thread_force_N_[static_cast<std::size_t>(t)].data();
-        Vec3* __restrict torque = thread_torque_N_m_[static_cast<std::size_t>(t)].data();
         std::size_t begin, end;
         thread_block(pairs, t, threads_, begin, end);
+        // The thread's pairs touch only particles lo..hi-1 (particles are ordered by cell, so a block of pairs
+        // spans a block of particles): only that range of its arrays is cleared here and read by the gather.
+        // Found once per neighbour list.
+        if (ranges_stale) {
+            std::uint32_t lo = std::numeric_limits<std::uint32_t>::max(), hi = 0;
+            for (std::size_t k = begin; k < end; ++k) {
+                lo = std::min(lo, std::min(pi[k], pj[k]));
+                hi = std::max(hi, std::max(pi[k], pj[k]));
+            }
+            thread_touched_[static_cast<std::size_t>(t)] = begin < end ? ParticleRange{lo, hi + 1} : ParticleRange{0, 0};
+        }
+        const ParticleRange range = thread_touched_[static_cast<std::size_t>(t)];
+        auto& thread_force = thread_force_N_[static_cast<std::size_t>(t)];
+        auto& thread_torque = thread_torque_N_m_[static_cast<std::size_t>(t)];
+        if (thread_force.size() != n) thread_force.resize(n);
+        if (thread_torque.size() != n) thread_torque.resize(n);
+        Vec3* __restrict force = thread_force.data();
+        Vec3* __restrict torque = thread_torque.data();
+        std::fill(force + range.begin, force + range.end, Vec3{});
+        std::fill(torque + range.begin, torque + range.end, Vec3{});
         double local_max = 0.0;
         PairBatch batch;  // the touching pairs, gathered for the SIMD law and scattered after it
 
@@ -944,6 +964,33 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
     }
 }
 
+void World::wall_thread_block(int t, std::size_t& begin, std::size_t& end) const
+{
+    // Blocks of particles with equal work: a wall candidate weighs as much as kCandidateWeight particles
+    // without one (the candidates sit at the bottom and the sides of a bed, so equal particle counts
+    // would give one thread most of the work). Bounds from the candidates' prefix sum by bisection.
+    const std::size_t n = particles_.size();
+    if (candidate_start_.size() != n + 1) {
+        thread_block(n, t, threads_, begin, end);
+        return;
+    }
+    constexpr std::size_t kCandidateWeight = 16;
+    auto weight = [&](std::size_t i) { return i + kCandidateWeight * candidate_start_[i]; };
+    const std::size_t total = weight(n);
+    auto bound = [&](int q) {
+        const std::size_t target = total * static_cast<std::size_t>(q) / static_cast<std::size_t>(threads_);
+        std::size_t lo = 0, hi = n;  // the first i with weight(i) >= target
+        while (lo < hi) {
+            const std::size_t mid = lo + (hi - lo) / 2;
+            if (weight(mid) < target) lo = mid + 1;
+            else hi = mid;
+        }
+        return lo;
+    };
+    begin = t == 0 ? 0 : bound(t);
+    end = t + 1 == threads_ ? n : bound(t + 1);
+}
+
 void World::compute_wall_contacts(double dt_s)
 {
     const std::size_t n = particles_.size();
@@ -952,15 +999,19 @@ void World::compute_wall_contacts(double dt_s)
     {
         const int t = omp_get_thread_num();
         std::size_t begin, end;
-        thread_block(n, t, threads_, begin, end);
-        auto& out = thread_wall_contacts_[static_cast<std::size_t>(t)];
-        auto& hits = thread_wall_hits_[static_cast<std::size_t>(t)];
+        wall_thread_block(t, begin, end);
+        // the thread's vectors are moved into locals while it fills them: their headers sit side by side in
+        // one cache line, and a push_back into the shared arrays would bounce that line between the cores
+        std::vector<WallContact> out = std::move(thread_wall_contacts_[static_cast<std::size_t>(t)]);
+        std::vector<WallHit> hits = std::move(thread_wall_hits_[static_cast<std::size_t>(t)]);
         out.clear();
         if (any_wall)
             for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, hits, out);
 
         // Last step's contacts have been read (their history): each thread's contacts, in particle order,
         // replace them at the thread's offset, and each thread indexes its own particles.
+        thread_wall_hits_[static_cast<std::size_t>(t)] = std::move(hits);
+        thread_wall_contacts_[static_cast<std::size_t>(t)] = std::move(out);
 #pragma omp barrier
 #pragma omp single
         {
@@ -972,7 +1023,8 @@ void World::compute_wall_contacts(double dt_s)
             wall_contact_start_[n] = static_cast<std::uint32_t>(wall_contacts_.size());
         }
         std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
-        std::copy(out.begin(), out.end(), wall_contacts_.begin() + static_cast<std::ptrdiff_t>(k));
+        const auto& filled = thread_wall_contacts_[static_cast<std::size_t>(t)];
+        std::copy(filled.begin(), filled.end(), wall_contacts_.begin() + static_cast<std::ptrdiff_t>(k));
         for (std::size_t i = begin; i < end; ++i) {
             wall_contact_start_[i] = static_cast<std::uint32_t>(k);
             while (k < wall_contact_offset_[static_cast<std::size_t>(t) + 1] && wall_contacts_[k].particle == i) ++k;
@@ -990,6 +1042,7 @@ void World::gather_forces_and_kick(double half_kick_s)
         Vec3 f = g * particles_.mass_kg[i];
         Vec3 torque{};
         for (std::size_t t = 0; t < thread_force_N_.size(); ++t) {
+            if (i < thread_touched_[t].begin || i >= thread_touched_[t].end) continue;
             f += thread_force_N_[t][i];
             torque += thread_torque_N_m_[t][i];
         }
@@ -1216,6 +1269,7 @@ void World::read_state(StateReader& in)
     in.array(pair_j_);
     in.array(pair_history_);
     in.array(pair_touching_);
+    ++pair_list_version_;
     in.array(reference_position_m_);
     in.array(stiffness_radius_N_per_m_);
     in.array(reference_mesh_rotation_);

@@ -158,6 +158,7 @@ private:
     };
 
     void sum_wall_reactions();
+    void wall_thread_block(int t, std::size_t& begin, std::size_t& end) const;
     void check_wall_name(const std::string& name) const;
     void validate_step();
     void check_initial_overlaps() const;
@@ -198,6 +199,11 @@ private:
     std::vector<std::uint8_t> pair_touching_;
     // pair forces and torques accumulated by each thread, added up per particle in thread order
     std::vector<std::vector<Vec3>> thread_force_N_, thread_torque_N_m_;
+    /// The particles each thread's block of pairs touches: its force arrays hold sums there, and nothing elsewhere.
+    struct ParticleRange { std::uint32_t begin = 0, end = 0; };
+    std::vector<ParticleRange> thread_touched_;
+    std::uint64_t pair_list_version_ = 0;       ///< counts changes of the neighbour pair list
+    std::uint64_t touched_ranges_version_ = ~std::uint64_t{0};  ///< the list thread_touched_ was found for
     std::vector<Vec3> reference_position_m_;
     std::vector<double> stiffness_radius_N_per_m_;  ///< k r per particle (eq. 4), refreshed at each rebuild
     std::vector<Mat3> reference_mesh_rotation_;     ///< each mesh's pose at the last rebuild

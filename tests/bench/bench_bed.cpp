@@ -112,6 +112,7 @@ int main(int argc, char** argv)
     if (static_cast<long>(world.particles().size()) != particles) usage("the bed does not hold N particles");
 
     const std::uint64_t rebuilds_before = world.rebuild_count();
+    const PhaseSeconds phases_before = world.phase_seconds();
     const auto start = clock::now();
     world.run_steps(static_cast<std::uint64_t>(steps));
     const double wall_s = std::chrono::duration<double>(clock::now() - start).count();
@@ -128,6 +129,10 @@ int main(int argc, char** argv)
     std::printf("neighbour pairs per particle: %.2f\n", static_cast<double>(world.neighbour_pair_count()) / static_cast<double>(particles));
     std::printf("neighbour rebuilds in timed steps: %llu\n", static_cast<unsigned long long>(world.rebuild_count() - rebuilds_before));
     std::printf("peak memory: %.1f MiB\n", static_cast<double>(peak_resident_kib()) / 1024.0);
+    const PhaseSeconds& p = world.phase_seconds();
+    std::printf("phases, s: sphere pairs %.3f, walls %.3f, neighbour search %.3f, integration %.3f\n",
+                p.pair_forces - phases_before.pair_forces, p.wall_forces - phases_before.wall_forces,
+                p.neighbour_search - phases_before.neighbour_search, p.integration - phases_before.integration);
     std::printf("wall time: %.3f s\n", wall_s);
     std::printf("particle-steps/s: %.0f\n", rate);
     return 0;
