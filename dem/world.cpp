@@ -469,8 +469,8 @@ void World::rebuild()
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         thread_block(n, t, threads_, begin, end);
-        auto& out_i = thread_i[static_cast<std::size_t>(t)];
-        auto& out_j = thread_j[static_cast<std::size_t>(t)];
+        // filled as locals and moved in at the end: the vectors' headers share a cache line (as below)
+        std::vector<std::uint32_t> out_i, out_j;
         for (std::size_t i = begin; i < end; ++i) {
             const Vec3 xi = particles_.position_m[i];
             const double ri = particles_.radius_m[i];
@@ -501,6 +501,8 @@ void World::rebuild()
                 }
             }
         }
+        thread_i[static_cast<std::size_t>(t)] = std::move(out_i);
+        thread_j[static_cast<std::size_t>(t)] = std::move(out_j);
     }
     pair_i_.clear();
     pair_j_.clear();
@@ -608,7 +610,7 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         thread_block(n, t, threads_, begin, end);
-        auto& out = per_thread[static_cast<std::size_t>(t)];
+        std::vector<MeshCandidate> out;  // a local, moved in at the end (the headers share a cache line)
         for (std::size_t i = begin; i < end; ++i) {
             const Vec3 p = particles_.position_m[i];
             int c[3];
@@ -641,6 +643,7 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
                 }
             }
         }
+        per_thread[static_cast<std::size_t>(t)] = std::move(out);
     }
     for (std::size_t i = 0; i < n; ++i) candidate_start_[i + 1] = candidate_start_[i] + counts[i];
     for (const auto& v : per_thread) candidates_.insert(candidates_.end(), v.begin(), v.end());
