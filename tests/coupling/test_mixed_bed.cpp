@@ -157,6 +157,18 @@ TEST_CASE("mixed bed bad input: fractions, a box too small, corrupt state files"
     std::filesystem::remove(path);
 }
 
+TEST_CASE("bulk density calibration bad input: densities, tolerance and scalings are named", "[coupling][unit]")
+{
+    // each is refused before any material is poured
+    const coupling::BulkDensityBox box;
+    CHECK_THROWS_WITH(coupling::calibrate_bulk_density(box, -3700.0, 1903.0),
+                      Catch::Contains("initial particle density") && Catch::Contains("-3700"));
+    CHECK_THROWS_WITH(coupling::calibrate_bulk_density(box, 3700.0, 0.0), Catch::Contains("target bulk density"));
+    CHECK_THROWS_WITH(coupling::calibrate_bulk_density(box, 3700.0, 1903.0, 0.0, 3), Catch::Contains("tolerance"));
+    CHECK_THROWS_WITH(coupling::calibrate_bulk_density(box, 3700.0, 1903.0, 0.02, 0),
+                      Catch::Contains("max_scalings is 0") && Catch::Contains("expected 1 or more"));
+}
+
 TEST_CASE("bulk density: scaling the particle density hits the target within 2 %", "[coupling][slow]")
 {
     // Thesis Paper A 3.1 on a box of half the sides (7 m3; the 28 m3 box is examples/bulk_density.cpp): weigh,
