@@ -454,6 +454,19 @@ std::size_t RigidWorld::contact_point_count() const
     return n;
 }
 
+RigidWorld::PairCounts RigidWorld::pair_counts() const
+{
+    PairCounts c;
+    c.broadphase_pairs = static_cast<std::size_t>(impl_->broadphase.getOverlappingPairCache()->getNumOverlappingPairs());
+    c.manifolds = static_cast<std::size_t>(impl_->dispatcher.getNumManifolds());
+    for (int q = 0; q < impl_->dispatcher.getNumManifolds(); ++q) {
+        const int points = impl_->dispatcher.getManifoldByIndexInternal(q)->getNumContacts();
+        c.contact_points += static_cast<std::size_t>(points);
+        c.touching_manifolds += points > 0 ? 1 : 0;
+    }
+    return c;
+}
+
 double RigidWorld::max_penetration_m() const
 {
     double deepest = 0.0;

@@ -35,6 +35,11 @@ struct RigidSettings {
     /// heap (slower, scattered in memory). Size it to the number of touching pairs expected (about 3.5 per
     /// rock in a pile).
     int contact_pool_size = 4096;
+    /// Narrow phase of two convex hulls (rock-rock, rock-plate). By default dipper's: the same contact points as
+    /// Bullet's convex-convex algorithm, but a contact manifold only for pairs within the breaking distance,
+    /// and a pair found apart is not searched again until the bodies' motion may have closed its gap
+    /// (docs/rigid.md). true: Bullet's own algorithm, for comparison.
+    bool bullet_convex_pairs = false;
 };
 
 /// Position, orientation and velocities of a body's centre of mass, world frame.
@@ -152,6 +157,12 @@ public:
     std::vector<ContactRecord> surface_contacts(BodyId surface, std::int32_t surface_id,
                                                 const meshes::TriangleMesh* wear_mesh = nullptr) const;
     std::size_t contact_point_count() const;
+    /// What Bullet's collision stages hold after the last step: pairs of bodies whose bounding boxes overlap
+    /// (broad phase), contact manifolds, manifolds with at least one point, and contact points.
+    struct PairCounts {
+        std::size_t broadphase_pairs = 0, manifolds = 0, touching_manifolds = 0, contact_points = 0;
+    };
+    PairCounts pair_counts() const;
     /// Deepest overlap among the contact points of the last step, m (0 if none overlap).
     double max_penetration_m() const;
     /// Kinetic energy of the dynamic bodies (rocks), J.

@@ -5,6 +5,7 @@
 #include "core/errors.h"
 #include "meshes/triangle_locator.h"
 #include "rigid/rigid_world.h"
+#include "rigid/detail/convex_pair.h"
 
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionDispatch/btInternalEdgeUtility.h>
@@ -13,6 +14,8 @@
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+#include <LinearMath/btPoolAllocator.h>
 
 #include <deque>
 #include <memory>
@@ -103,11 +106,14 @@ struct RigidWorld::Impl {
         info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
         info.m_splitImpulse = 1;
         info.m_splitImpulsePenetrationThreshold = -s.split_impulse_threshold_m;
+        if (!s.bullet_convex_pairs)
+            dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, CONVEX_HULL_SHAPE_PROXYTYPE, &convex_pairs);
     }
     ~Impl();  // rope_shovel.cpp: the shovel's multibody goes first
 
     RigidSettings settings;
     btDefaultCollisionConfiguration config;
+    ConvexPairCreateFunc convex_pairs{config.getCollisionAlgorithmPool()->getElementSize()};  // outlives the world's pairs
     btCollisionDispatcher dispatcher{&config};
     btDbvtBroadphase broadphase;
     btMultiBodyConstraintSolver solver;

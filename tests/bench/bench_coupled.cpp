@@ -2,9 +2,10 @@
 // coupling sub-step counts n, against the same bed stepped by the DEM alone (rocks held as fixed surfaces).
 // Spheres 200 mm; rocks of Table 1's classes in Table 1's mass ratios among themselves; Aitik ore (Table 2).
 // Usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]
-//                             [--substeps 1,5,10,20] [--cache FILE]
+//                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet]
 // The bed is filled loosely in a box, settled for --settle-s at n = 10 and saved to --cache (a later run loads
 // it); each variant then starts from that state, takes 200 DEM steps to warm up, and times --steps DEM steps.
+// --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
 #include "coupling/coupled_world.h"
 #include "coupling/mixed_bed.h"
 #include "meshes/mesh_builder.h"
@@ -30,16 +31,17 @@ struct Bed {
     dem::World dem;
     rigid::RigidWorld rigid;
     coupling::CoupledWorld world;
-    Bed(double dt, int threads, int substeps)
+    Bed(double dt, int threads, int substeps, bool bullet_pairs)
         : dem(dem::MaterialTable::aitik_copper_ore(), [&] {
               dem::WorldSettings s;
               s.step_s = dt;
               s.threads = threads;
               return s;
           }()),
-          rigid([] {
+          rigid([&] {
               rigid::RigidSettings s;
               s.contact_pool_size = 8192;
+              s.bullet_convex_pairs = bullet_pairs;
               return s;
           }()),
           world(dem, rigid, coupling::CouplingSettings{substeps})
@@ -73,9 +75,10 @@ int main(int argc, char** argv)
     int spheres = 20000, rocks = 1000, threads = 1, steps = 400;
     double dt = 5e-5, settle_s = 0.6;
     std::string cache, substeps_list = "1,5,10,20";
+    bool bullet_pairs = false;
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
-        "                            [--substeps 1,5,10,20] [--cache FILE]\n";
+        "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet]\n";
     const int status = bench::read_options(argc, argv, usage, [&](const std::string& key, const char* value) {
         if (key == "--spheres") spheres = std::atoi(value);
         else if (key == "--rocks") rocks = std::atoi(value);
@@ -85,6 +88,8 @@ int main(int argc, char** argv)
         else if (key == "--settle-s") settle_s = std::atof(value);
         else if (key == "--substeps") substeps_list = value;
         else if (key == "--cache") cache = value;
+        else if (key == "--pairs" && (std::string(value) == "dipper" || std::string(value) == "bullet"))
+            bullet_pairs = std::string(value) == "bullet";
         else return false;
         return true;
     });
@@ -116,7 +121,7 @@ int main(int argc, char** argv)
 
     if (cache.empty() || !std::filesystem::exists(cache)) {
         const auto t0 = std::chrono::steady_clock::now();
-        Bed bed(dt, threads, 10);
+        Bed bed(dt, threads, 10, bullet_pairs);
         bed.add_box(side, height + 1.0);
         const auto materials = coupling::MixedMaterials{bed.dem.materials().index_of("ore"), bed.dem.materials().index_of("rock"),
                                                         bed.rigid.material_index("rock"), density};
@@ -140,7 +145,7 @@ int main(int argc, char** argv)
     double dem_only_total = 0.0;
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
     for (int n : variants) {
-        Bed bed(dt, threads, std::max(n, 1));
+        Bed bed(dt, threads, std::max(n, 1), bullet_pairs);
         bed.add_box(side, height + 1.0);
         coupling::load_state(bed.world, cache);
         const int warm = 200;

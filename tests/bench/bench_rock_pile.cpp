@@ -2,10 +2,11 @@
 // the pile's weight. Rocks of the thesis' size classes (Table 1 mass fractions 300/400/600/850 mm =
 // 10/9/19/25) are dropped from a loose lattice onto the ground and settled; then steps are timed.
 // Usage: dipper_bench_rock_pile [--rocks N] [--dt S] [--settle-s S] [--settle-dt S] [--steps N] [--point-count N]
-//                               [--iterations N] [--margin-fraction F] [--pool N]
+//                               [--iterations N] [--margin-fraction F] [--pool N] [--pairs dipper|bullet]
 // The pile settles at --settle-dt (default 1e-3 s), then takes 100 steps at --dt before the timed ones.
 // --dt may list several steps (--dt 1e-3,1e-4): the settled pile is timed at each in turn, so a large
-// pile settles once.
+// pile settles once. --pairs bullet steps hull pairs with Bullet's own convex-convex algorithm instead of
+// dipper's (RigidSettings::bullet_convex_pairs), for comparison.
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"
 #include "tests/bench/options.h"
@@ -29,9 +30,11 @@ int main(int argc, char** argv)
 {
     int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 4096;
     double settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
+    bool bullet_pairs = false;
     std::vector<double> dts{1e-3};
     const char* help = "usage: dipper_bench_rock_pile [--rocks N] [--dt S[,S...]] [--settle-s S] [--settle-dt S] [--steps N]\n"
-                        "                              [--point-count N] [--iterations N] [--pool N] [--margin-fraction F]\n";
+                        "                              [--point-count N] [--iterations N] [--pool N] [--margin-fraction F]\n"
+                       "                              [--pairs dipper|bullet]\n";
     const int status = bench::read_options(argc, argv, help, [&](const std::string& key, const char* value) {
         if (key == "--rocks") rocks = std::atoi(value);
         else if (key == "--dt") {
@@ -47,6 +50,8 @@ int main(int argc, char** argv)
         else if (key == "--iterations") iterations = std::atoi(value);
         else if (key == "--pool") pool = std::atoi(value);
         else if (key == "--margin-fraction") margin_fraction = std::atof(value);
+        else if (key == "--pairs" && (std::strcmp(value, "dipper") == 0 || std::strcmp(value, "bullet") == 0))
+            bullet_pairs = std::strcmp(value, "bullet") == 0;
         else return false;
         return true;
     });
@@ -56,6 +61,7 @@ int main(int argc, char** argv)
     settings.solver_iterations = iterations;
     settings.contact_pool_size = pool;
     settings.rock_margin_fraction = margin_fraction;
+    settings.bullet_convex_pairs = bullet_pairs;
     RigidWorld w(settings);
     w.add_material("rock");
     w.add_material("ground");
@@ -108,6 +114,8 @@ int main(int argc, char** argv)
         std::printf("rocks %d  dt %g s\n", rocks, dt);
         std::printf("  median step %.3f ms = %.1f us per rock per step; contact points %zu\n", median * 1e3,
                     median / rocks * 1e6, w.contact_point_count());
+        const RigidWorld::PairCounts pc = w.pair_counts();
+        std::printf("  broad-phase pairs %zu, manifolds %zu (%zu with points)\n", pc.broadphase_pairs, pc.manifolds, pc.touching_manifolds);
         std::printf("  ground reaction / weight %.5f (mean of %d steps); kinetic energy %.4g J; deepest overlap %.2f mm\n",
                     reaction / steps / weight, steps, w.kinetic_energy_J(), w.max_penetration_m() * 1e3);
         std::printf("  peak memory %.1f MB (%.1f kB per rock)\n", usage.ru_maxrss / 1024.0, usage.ru_maxrss / static_cast<double>(rocks));
