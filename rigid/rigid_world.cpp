@@ -529,7 +529,7 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
     const btTransform to_part = (part.object()->getWorldTransform() * part.part_in_object).inverse();
     const double dt = impl_->settings.step_s;
     std::vector<ContactRecord> out;
-    std::vector<const void*> now_touching;
+    std::vector<int> now_touching;
     const bool continues = part.touching_step + 1 == impl_->step_count;  // reported for the step before too
     btDispatcher& d = impl_->dispatcher;
     for (int q = 0; q < d.getNumManifolds(); ++q) {
@@ -539,15 +539,19 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
         if (!surface_is_a && !surface_is_b) continue;
         const auto* other = btRigidBody::upcast(surface_is_a ? m->getBody1() : m->getBody0());
         if (!other || other->getInvMass() == 0.0) continue;  // rocks only
-        // An impact is the start of contact between the rock and the part: the first touching point of a
-        // manifold that did not touch in the previous step. (Bullet keeps points a little apart in its
-        // manifolds, and adds a landing face's points over several steps; neither is a new impact.)
+        // An impact is the start of contact between the rock and the part: the first touching point of a rock
+        // that touched none of the part's manifolds in the previous step. (Bullet keeps points a little apart
+        // in its manifolds, and adds a landing face's points over several steps; neither is a new impact. A
+        // rock across two plates of a part has a manifold on each: still one impact. Rocks, not manifolds,
+        // are remembered: a manifold released in one step can be handed to another pair in the next.)
         const auto touches = [](const btManifoldPoint& p) { return p.getDistance() <= 0.0 || p.m_appliedImpulse > 0.0; };
         bool touching = false;
         for (int k = 0; k < m->getNumContacts(); ++k) touching = touching || touches(m->getContactPoint(k));
         if (!touching) continue;
-        now_touching.push_back(m);
-        const bool new_contact = !continues || !std::binary_search(part.touching.begin(), part.touching.end(), static_cast<const void*>(m));
+        const int rock = other->getUserIndex2();
+        const bool seen = std::find(now_touching.begin(), now_touching.end(), rock) != now_touching.end();
+        if (!seen) now_touching.push_back(rock);
+        const bool new_contact = !seen && (!continues || !std::binary_search(part.touching.begin(), part.touching.end(), rock));
         bool impact_given = false;
         for (int k = 0; k < m->getNumContacts(); ++k) {
             const btManifoldPoint& p = m->getContactPoint(k);

@@ -76,7 +76,7 @@ struct RigidWorld::Impl {
         int link = -1;
         btTransform previous_pose = btTransform::getIdentity();  ///< for link velocities by finite difference
         btTransform part_in_object = btTransform::getIdentity();  ///< the part's own frame in the object's frame
-        std::vector<const void*> touching;  ///< manifolds with this part that touched in the last reported step
+        std::vector<int> touching;  ///< rocks (body ids) that touched this part in the last reported step
         std::uint64_t touching_step = 0;
 
         btCollisionObject* object() const { return body ? static_cast<btCollisionObject*>(body.get()) : link_collider.get(); }
