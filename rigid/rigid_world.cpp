@@ -446,13 +446,7 @@ Vec3 RigidWorld::contact_force_N(BodyId id) const
     return impl_->contact_force[static_cast<std::size_t>(id)];
 }
 
-std::size_t RigidWorld::contact_point_count() const
-{
-    std::size_t n = 0;
-    for (int q = 0; q < impl_->dispatcher.getNumManifolds(); ++q)
-        n += static_cast<std::size_t>(impl_->dispatcher.getManifoldByIndexInternal(q)->getNumContacts());
-    return n;
-}
+std::size_t RigidWorld::contact_point_count() const { return pair_counts().contact_points; }
 
 RigidWorld::PairCounts RigidWorld::pair_counts() const
 {

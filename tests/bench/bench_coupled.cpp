@@ -75,7 +75,7 @@ int main(int argc, char** argv)
     int spheres = 20000, rocks = 1000, threads = 1, steps = 400;
     double dt = 5e-5, settle_s = 0.6;
     std::string cache, substeps_list = "1,5,10,20";
-    bool bullet_pairs = false;
+    std::string pairs = "dipper";
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
         "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet]\n";
@@ -88,12 +88,16 @@ int main(int argc, char** argv)
         else if (key == "--settle-s") settle_s = std::atof(value);
         else if (key == "--substeps") substeps_list = value;
         else if (key == "--cache") cache = value;
-        else if (key == "--pairs" && (std::string(value) == "dipper" || std::string(value) == "bullet"))
-            bullet_pairs = std::string(value) == "bullet";
+        else if (key == "--pairs") pairs = value;
         else return false;
         return true;
     });
     if (status >= 0) return status;
+    if (pairs != "dipper" && pairs != "bullet") {
+        std::fprintf(stderr, "--pairs is '%s'; expected dipper or bullet\n", pairs.c_str());
+        return 2;
+    }
+    const bool bullet_pairs = pairs == "bullet";
     std::vector<int> variants;
     {
         std::stringstream ss(substeps_list);

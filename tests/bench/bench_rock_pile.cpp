@@ -30,7 +30,7 @@ int main(int argc, char** argv)
 {
     int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 4096;
     double settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
-    bool bullet_pairs = false;
+    std::string pairs = "dipper";
     std::vector<double> dts{1e-3};
     const char* help = "usage: dipper_bench_rock_pile [--rocks N] [--dt S[,S...]] [--settle-s S] [--settle-dt S] [--steps N]\n"
                         "                              [--point-count N] [--iterations N] [--pool N] [--margin-fraction F]\n"
@@ -50,12 +50,16 @@ int main(int argc, char** argv)
         else if (key == "--iterations") iterations = std::atoi(value);
         else if (key == "--pool") pool = std::atoi(value);
         else if (key == "--margin-fraction") margin_fraction = std::atof(value);
-        else if (key == "--pairs" && (std::strcmp(value, "dipper") == 0 || std::strcmp(value, "bullet") == 0))
-            bullet_pairs = std::strcmp(value, "bullet") == 0;
+        else if (key == "--pairs") pairs = value;
         else return false;
         return true;
     });
     if (status >= 0) return status;
+    if (pairs != "dipper" && pairs != "bullet") {
+        std::fprintf(stderr, "--pairs is '%s'; expected dipper or bullet\n", pairs.c_str());
+        return 2;
+    }
+    const bool bullet_pairs = pairs == "bullet";
     RigidSettings settings;
     settings.step_s = settle_dt;
     settings.solver_iterations = iterations;
