@@ -284,18 +284,20 @@ void CoupledWorld::step()
 
     // 2. and 3. the DEM sub-steps, the surfaces moving from the old poses to the new ones
     const int n = settings_.substeps;
-    for (int s = 1; s <= n; ++s) {
-        mark = std::chrono::steady_clock::now();
-        move_surfaces(static_cast<double>(s) / n);
-        now = std::chrono::steady_clock::now();
-        surface_seconds_ += std::chrono::duration<double>(now - mark).count();
-        dem_.step();
+    dem::World::StepHooks hooks;
+    hooks.before_forces = [&](std::uint64_t s) {
+        const auto start = std::chrono::steady_clock::now();
+        move_surfaces(static_cast<double>(s + 1) / n);
+        surface_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    hooks.after_forces = [&](std::uint64_t) {
         for (std::size_t k = 0; k < bodies_.size(); ++k) {
             force_sum_[k] += dem_.wall_force_N(bodies_[k].wall);
             torque_sum_[k] += dem_.wall_torque_N_m(bodies_[k].wall);
         }
         ++samples_;
-    }
+    };
+    dem_.run_steps(static_cast<std::uint64_t>(n), hooks);
 }
 
 void CoupledWorld::run_steps(std::uint64_t n)

@@ -164,16 +164,16 @@ void World::set_wall_mass_kg(int wall_id, double mass_kg)
 
 void World::sum_wall_reactions()
 {
-    // in list order, so the sums are deterministic
-    std::fill(wall_force_N_.begin(), wall_force_N_.end(), Vec3{});
-    std::fill(wall_torque_N_m_.begin(), wall_torque_N_m_.end(), Vec3{});
-    for (const WallContact& c : wall_contacts_) {
-        const auto w = static_cast<std::size_t>(c.wall);
-        const Vec3 on_wall = -(c.normal * c.forces.normal_force_N + c.forces.tangential_force_N);
-        const WallRef& ref = walls_[w];
-        const Vec3 about = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].reference_point_m() : Vec3{};
-        wall_force_N_[w] += on_wall;
-        wall_torque_N_m_[w] += cross(c.point - about, on_wall) - c.forces.rolling_torque_N_m;
+    // each thread summed its contacts in list order (compute_wall_contacts); the threads' sums are added
+    // in thread order, so the totals are deterministic for a thread count (and the list-order sums on one)
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        Vec3 force = thread_wall_force_N_[0][w], torque = thread_wall_torque_N_m_[0][w];
+        for (std::size_t t = 1; t < thread_wall_force_N_.size(); ++t) {
+            force += thread_wall_force_N_[t][w];
+            torque += thread_wall_torque_N_m_[t][w];
+        }
+        wall_force_N_[w] = force;
+        wall_torque_N_m_[w] = torque;
     }
 }
 
@@ -266,54 +266,79 @@ void World::evaluate_forces(double dt_s, double half_kick_s)
     phase_seconds_.pair_forces += seconds_since(mark);
     compute_wall_contacts(dt_s);
     phase_seconds_.wall_forces += seconds_since(mark);
-    gather_forces_and_kick(half_kick_s);
+    gather_forces_and_kick(half_kick_s, false);
     phase_seconds_.integration += seconds_since(mark);
-}
-
-void World::run_steps(std::uint64_t n)
-{
-    for (std::uint64_t s = 0; s < n; ++s) step();
 }
 
 void World::step()
 {
+    run_steps(1);
+}
+
+void World::run_steps(std::uint64_t n, const StepHooks& hooks)
+{
+    if (n == 0) return;
     prepare();
     const double dt = step_s_;
     if (!(dt > 0.0)) throw InputError("the world has no particles to derive a time step from and step_s is 0");
-    const std::size_t n = particles_.size();
-    auto& x = particles_.position_m;
-    auto& v = particles_.velocity_m_per_s;
-    auto& w = particles_.angular_velocity_rad_per_s;
 
     auto mark = std::chrono::steady_clock::now();
     // first half kick with last step's forces, then drift (velocity Verlet); the largest move since the
     // last neighbour-list rebuild comes along
+    double max_move2 = kick_and_drift(dt);
+    phase_seconds_.integration += seconds_since(mark);
+
+    for (std::uint64_t s = 0; s < n; ++s) {
+        if (hooks.before_forces) hooks.before_forces(s);
+        mark = std::chrono::steady_clock::now();
+        // moving walls to the end of the step, their velocities at mid-step
+        move_prescribed_meshes(time_s_ + dt, dt);
+        phase_seconds_.integration += seconds_since(mark);
+
+        // neighbour lists, rebuilt when a particle or a wall has used up the skin
+        const bool tracked = reference_position_m_.size() == particles_.size();
+        if (rebuild_needed_ || !tracked || needs_rebuild(std::sqrt(max_move2))) rebuild();
+        phase_seconds_.neighbour_search += seconds_since(mark);
+
+        // forces: sphere pairs into per-thread arrays, wall contacts per particle
+        compute_pair_forces(dt);
+        phase_seconds_.pair_forces += seconds_since(mark);
+        compute_wall_contacts(dt);
+        phase_seconds_.wall_forces += seconds_since(mark);
+
+        // the step's wall reactions and contact records depend on the wall contacts alone
+        finish_step(dt);
+        phase_seconds_.integration += seconds_since(mark);
+        if (hooks.after_forces) hooks.after_forces(s);
+
+        // per particle the sum of its forces and the second half kick; between two steps of this call,
+        // the next step's first half kick and drift in the same pass (the same operations in the same
+        // order as two passes, so the same bits)
+        if (s + 1 < n)
+            max_move2 = gather_forces_and_kick(0.5 * dt, true);
+        else
+            gather_forces_and_kick(0.5 * dt, false);
+        phase_seconds_.integration += seconds_since(mark);
+    }
+}
+
+double World::kick_and_drift(double dt_s)
+{
+    const std::size_t n = particles_.size();
+    auto& x = particles_.position_m;
+    auto& v = particles_.velocity_m_per_s;
+    auto& w = particles_.angular_velocity_rad_per_s;
     const bool tracked = reference_position_m_.size() == n;
     const Vec3* reference = reference_position_m_.data();
     double max_move2 = 0.0;
 #pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : max_move2)
     for (std::size_t i = 0; i < n; ++i) {
-        v[i] += particles_.force_N[i] * (0.5 * dt * particles_.inverse_mass_per_kg[i]);
-        w[i] += particles_.torque_N_m[i] * (0.5 * dt * particles_.inverse_inertia_per_kg_m2[i]);
-        x[i] += v[i] * dt;
+        v[i] += particles_.force_N[i] * (0.5 * dt_s * particles_.inverse_mass_per_kg[i]);
+        w[i] += particles_.torque_N_m[i] * (0.5 * dt_s * particles_.inverse_inertia_per_kg_m2[i]);
+        x[i] += v[i] * dt_s;
         if (tracked) max_move2 = std::max(max_move2, norm_squared(x[i] - reference[i]));
     }
-
-    // moving walls to the end of the step, their velocities at mid-step
-    move_prescribed_meshes(time_s_ + dt, dt);
-
-    phase_seconds_.integration += seconds_since(mark);
-
-    // neighbour lists, rebuilt when a particle or a wall has used up the skin
-    if (rebuild_needed_ || !tracked || needs_rebuild(std::sqrt(max_move2))) rebuild();
-    phase_seconds_.neighbour_search += seconds_since(mark);
-
-    // forces: sphere pairs into per-thread arrays, wall contacts per particle, then per particle the sum
-    // and the second half kick
-    evaluate_forces(dt, 0.5 * dt);
-    mark = std::chrono::steady_clock::now();
-    finish_step(dt);
-    phase_seconds_.integration += seconds_since(mark);
+    return max_move2;
 }
 
 void World::move_prescribed_meshes(double t_end_s, double dt_s)
@@ -349,7 +374,28 @@ void World::finish_step(double dt_s)
 
     sum_wall_reactions();
 
-    // surface contact records for consumers (wear)
+    if (consumer_) consumer_(last_contact_records(), time_s_, dt_s);
+
+    // the first wall contact (in list order) past the overlap limit, found by the wall phase
+    std::size_t first = kNoContact;
+    for (std::size_t f : thread_first_deep_contact_) first = std::min(first, f);
+    if (first != kNoContact) {
+        const WallContact& c = wall_contacts_[first];
+        const double ratio = c.overlap_m / particles_.radius_m[c.particle];
+        const Vec3 p = particles_.position_m[c.particle];
+        throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
+                                     wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",
+                                     " by ", ratio, " of its radius (limit ", settings_.max_overlap_ratio, ") at (",
+                                     p.x, ", ", p.y, ", ", p.z, "), speed ", norm(particles_.velocity_m_per_s[c.particle]),
+                                     " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
+                                     " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall"));
+    }
+    if (max_overlap_ratio_ > settings_.max_overlap_ratio) fail_overlap();
+}
+
+const std::vector<ContactRecord>& World::last_contact_records() const
+{
+    if (!records_stale_) return records_;
     records_.resize(wall_contacts_.size());
 #pragma omp parallel for schedule(static) num_threads(threads_)
     for (std::size_t k = 0; k < wall_contacts_.size(); ++k) {
@@ -367,21 +413,8 @@ void World::finish_step(double dt_s)
         r.particle_mass_kg = particles_.mass_kg[c.particle];
         r.first_step = c.first_step;
     }
-    if (consumer_) consumer_(records_, time_s_, dt_s);
-
-    for (const WallContact& c : wall_contacts_) {
-        const double ratio = c.overlap_m / particles_.radius_m[c.particle];
-        if (ratio > settings_.max_overlap_ratio) {
-            const Vec3 p = particles_.position_m[c.particle];
-            throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
-                                         wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",
-                                         " by ", ratio, " of its radius (limit ", settings_.max_overlap_ratio, ") at (",
-                                         p.x, ", ", p.y, ", ", p.z, "), speed ", norm(particles_.velocity_m_per_s[c.particle]),
-                                         " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
-                                         " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall"));
-        }
-    }
-    if (max_overlap_ratio_ > settings_.max_overlap_ratio) fail_overlap();
+    records_stale_ = false;
+    return records_;
 }
 
 std::string World::where_in_time() const
@@ -685,6 +718,7 @@ void World::compute_pair_forces(double dt_s)
     thread_force_N_.resize(static_cast<std::size_t>(threads_));
     thread_torque_N_m_.resize(static_cast<std::size_t>(threads_));
     const bool ranges_stale = touched_ranges_version_ != pair_list_version_ || thread_touched_.size() != static_cast<std::size_t>(threads_);
+    if (thread_touched_.size() != static_cast<std::size_t>(threads_)) thread_forces_clear_ = false;
     thread_touched_.resize(static_cast<std::size_t>(threads_));
     touched_ranges_version_ = pair_list_version_;
 
@@ -706,15 +740,17 @@ void World::compute_pair_forces(double dt_s)
             }
             thread_touched_[static_cast<std::size_t>(t)] = begin < end ? ParticleRange{lo, hi + 1} : ParticleRange{0, 0};
         }
-        const ParticleRange range = thread_touched_[static_cast<std::size_t>(t)];
         auto& thread_force = thread_force_N_[static_cast<std::size_t>(t)];
         auto& thread_torque = thread_torque_N_m_[static_cast<std::size_t>(t)];
         if (thread_force.size() != n) thread_force.resize(n);
         if (thread_torque.size() != n) thread_torque.resize(n);
         Vec3* __restrict force = thread_force.data();
         Vec3* __restrict torque = thread_torque.data();
-        std::fill(force + range.begin, force + range.end, Vec3{});
-        std::fill(torque + range.begin, torque + range.end, Vec3{});
+        // the gather leaves every element it reads at zero; only after an interrupted step are they cleared here
+        if (!thread_forces_clear_) {
+            std::fill(thread_force.begin(), thread_force.end(), Vec3{});
+            std::fill(thread_torque.begin(), thread_torque.end(), Vec3{});
+        }
         double local_max = 0.0;
         PairBatch batch;  // the touching pairs, gathered for the SIMD law and scattered after it
 
@@ -787,6 +823,7 @@ void World::compute_pair_forces(double dt_s)
         max_ratio = std::max(max_ratio, local_max);
     }
     max_overlap_ratio_ = max_ratio;
+    thread_forces_clear_ = false;  // until the gather has read them
 }
 
 void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const
@@ -1024,6 +1061,13 @@ void World::compute_wall_contacts(double dt_s)
             wall_contacts_.resize(wall_contact_offset_.back());
             wall_contact_start_.resize(n + 1);
             wall_contact_start_[n] = static_cast<std::uint32_t>(wall_contacts_.size());
+            thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));
+            thread_wall_torque_N_m_.resize(static_cast<std::size_t>(threads_));
+            for (std::size_t q = 0; q < static_cast<std::size_t>(threads_); ++q) {
+                thread_wall_force_N_[q].resize(walls_.size());
+                thread_wall_torque_N_m_[q].resize(walls_.size());
+            }
+            thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
         }
         std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
         const auto& filled = thread_wall_contacts_[static_cast<std::size_t>(t)];
@@ -1032,15 +1076,44 @@ void World::compute_wall_contacts(double dt_s)
             wall_contact_start_[i] = static_cast<std::uint32_t>(k);
             while (k < wall_contact_offset_[static_cast<std::size_t>(t) + 1] && wall_contacts_[k].particle == i) ++k;
         }
+
+        // the thread's share of each wall's reaction, in list order, and its first contact past the
+        // overlap limit
+        Vec3* __restrict wall_force = thread_wall_force_N_[static_cast<std::size_t>(t)].data();
+        Vec3* __restrict wall_torque = thread_wall_torque_N_m_[static_cast<std::size_t>(t)].data();
+        std::fill(wall_force, wall_force + walls_.size(), Vec3{});
+        std::fill(wall_torque, wall_torque + walls_.size(), Vec3{});
+        std::size_t first_deep = kNoContact;
+        const std::size_t offset = wall_contact_offset_[static_cast<std::size_t>(t)];
+        for (std::size_t q = 0; q < filled.size(); ++q) {
+            const WallContact& c = filled[q];
+            const auto w = static_cast<std::size_t>(c.wall);
+            const Vec3 on_wall = -(c.normal * c.forces.normal_force_N + c.forces.tangential_force_N);
+            const WallRef& ref = walls_[w];
+            const Vec3 about = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].reference_point_m() : Vec3{};
+            wall_force[w] += on_wall;
+            wall_torque[w] += cross(c.point - about, on_wall) - c.forces.rolling_torque_N_m;
+            if (first_deep == kNoContact && c.overlap_m / particles_.radius_m[c.particle] > settings_.max_overlap_ratio)
+                first_deep = offset + q;
+        }
+        thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
     }
+    records_stale_ = true;
 }
 
-void World::gather_forces_and_kick(double half_kick_s)
+double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
 {
     const std::size_t n = particles_.size();
     const Vec3 g = settings_.gravity_m_per_s2;
+    const double dt = 2.0 * half_kick_s;
+    const bool tracked = next_drift && reference_position_m_.size() == n;
+    const Vec3* reference = reference_position_m_.data();
+    auto& x = particles_.position_m;
+    auto& v = particles_.velocity_m_per_s;
+    auto& w = particles_.angular_velocity_rad_per_s;
+    double max_move2 = 0.0;
     int bad = -1;
-#pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : bad)
+#pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : bad, max_move2)
     for (std::size_t i = 0; i < n; ++i) {
         Vec3 f = g * particles_.mass_kg[i];
         Vec3 torque{};
@@ -1048,19 +1121,33 @@ void World::gather_forces_and_kick(double half_kick_s)
             if (i < thread_touched_[t].begin || i >= thread_touched_[t].end) continue;
             f += thread_force_N_[t][i];
             torque += thread_torque_N_m_[t][i];
+            thread_force_N_[t][i] = Vec3{};  // cleared for the next step's pairs while in cache
+            thread_torque_N_m_[t][i] = Vec3{};
         }
         for (std::uint32_t k = wall_contact_start_[i]; k < wall_contact_start_[i + 1]; ++k) {
             const WallContact& c = wall_contacts_[k];
             const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
             f += force;
-            torque += cross(c.point - particles_.position_m[i], force) + c.forces.rolling_torque_N_m;
+            torque += cross(c.point - x[i], force) + c.forces.rolling_torque_N_m;
         }
-        particles_.force_N[i] = f;
-        particles_.torque_N_m[i] = torque;
-        particles_.velocity_m_per_s[i] += f * (half_kick_s * particles_.inverse_mass_per_kg[i]);
-        particles_.angular_velocity_rad_per_s[i] += torque * (half_kick_s * particles_.inverse_inertia_per_kg_m2[i]);
-        if (!is_finite(f) || !is_finite(torque) || !is_finite(particles_.position_m[i])) bad = std::max(bad, static_cast<int>(i));
+        if (!next_drift) {  // within a run of steps the force is used here and nowhere else
+            particles_.force_N[i] = f;
+            particles_.torque_N_m[i] = torque;
+        }
+        const Vec3 dv = f * (half_kick_s * particles_.inverse_mass_per_kg[i]);
+        const Vec3 dw = torque * (half_kick_s * particles_.inverse_inertia_per_kg_m2[i]);
+        v[i] += dv;
+        w[i] += dw;
+        if (!is_finite(f) || !is_finite(torque) || !is_finite(x[i])) bad = std::max(bad, static_cast<int>(i));
+        if (next_drift) {
+            // the next step's first half kick (the same force, the same factor) and drift
+            v[i] += dv;
+            w[i] += dw;
+            x[i] += v[i] * dt;
+            if (tracked) max_move2 = std::max(max_move2, norm_squared(x[i] - reference[i]));
+        }
     }
+    thread_forces_clear_ = true;
     if (bad >= 0) {
         const auto i = static_cast<std::size_t>(bad);
         throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[i], " has a non-finite force or position (x = ",
@@ -1068,6 +1155,7 @@ void World::gather_forces_and_kick(double half_kick_s)
                                      particles_.position_m[i].z, "); step_s = ", step_s_,
                                      " s; try step_s <= ", 0.5 * step_s_, " s (stable limit ", stable_step_limit_s(), " s)"));
     }
+    return max_move2;
 }
 
 [[noreturn]] void World::fail_overlap() const
@@ -1314,6 +1402,7 @@ void World::read_state(StateReader& in)
     if (wall_force_N_.size() != walls_.size() || wall_torque_N_m_.size() != walls_.size())
         wall_force_N_.assign(walls_.size(), Vec3{}), wall_torque_N_m_.assign(walls_.size(), Vec3{});
     records_.clear();
+    records_stale_ = true;
 }
 
 }  // namespace dipper::dem

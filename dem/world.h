@@ -9,6 +9,7 @@
 #include "dem/walls.h"
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,8 +76,17 @@ public:
     /// Advances one step: half kick and drift, walls moved, neighbour lists refreshed if needed,
     /// forces, second half kick. Throws SimulationError with a diagnosis if the state blows up.
     void step();
-    /// Advances n steps.
-    void run_steps(std::uint64_t n);
+    /// Called between the steps of run_steps with the index of the step within the call. before_forces
+    /// runs after the particles' drift and before the walls are moved and the forces found (it may place
+    /// mesh walls with set_mesh_pose; it must not change particles); after_forces runs once the step's
+    /// wall reactions and contact records are final, before the particles' second half kick.
+    struct StepHooks {
+        std::function<void(std::uint64_t)> before_forces;
+        std::function<void(std::uint64_t)> after_forces;
+    };
+    /// Advances n steps; the same as n calls of step(), bit for bit, with one pass over the particles
+    /// fewer per step (the second half kick of a step and the first of the next share it).
+    void run_steps(std::uint64_t n, const StepHooks& hooks = {});
     /// Makes the next step rebuild the neighbour lists (history is carried over as always).
     void request_rebuild() { rebuild_needed_ = true; }
 
@@ -118,7 +128,7 @@ public:
     /// wall forces and torques are then those of the initial state. Called by step() when needed.
     void prepare();
     /// Surface contacts of the last step.
-    const std::vector<ContactRecord>& last_contact_records() const { return records_; }
+    const std::vector<ContactRecord>& last_contact_records() const;  ///< built when first asked for
     std::size_t pair_contact_count() const;          ///< touching sphere pairs in the last step
     std::size_t wall_contact_count() const { return wall_contacts_.size(); }
     std::size_t neighbour_pair_count() const { return pair_i_.size(); }
@@ -171,7 +181,10 @@ private:
     void compute_pair_forces(double dt_s);
     void compute_wall_contacts(double dt_s);
     void find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const;
-    void gather_forces_and_kick(double half_kick_s);
+    /// Sums each particle's forces and kicks it by half_kick_s; with next_drift also gives it the next
+    /// step's first half kick and drift and returns the largest squared move since the last rebuild.
+    double gather_forces_and_kick(double half_kick_s, bool next_drift);
+    double kick_and_drift(double dt_s);
     void finish_step(double dt_s);
     [[noreturn]] void fail_overlap() const;
     std::string where_in_time() const;
@@ -192,6 +205,7 @@ private:
     double time_s_ = 0.0, step_s_ = 0.0;
     std::uint64_t step_count_ = 0, rebuild_count_ = 0;
     bool prepared_ = false, rebuild_needed_ = true, step_checked_ = false;
+    bool thread_forces_clear_ = false;  ///< every per-thread force array is all zero (the gather clears what it reads)
 
     // neighbour list: pairs (i < j) sorted by i then j, with their contact history
     std::vector<std::uint32_t> pair_i_, pair_j_;
@@ -222,7 +236,11 @@ private:
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
-    std::vector<ContactRecord> records_;
+    std::vector<std::vector<Vec3>> thread_wall_force_N_, thread_wall_torque_N_m_;  ///< per thread and wall, this step
+    static constexpr std::size_t kNoContact = static_cast<std::size_t>(-1);
+    std::vector<std::size_t> thread_first_deep_contact_;  ///< per thread: first wall contact past the overlap limit
+    mutable std::vector<ContactRecord> records_;
+    mutable bool records_stale_ = true;
     double max_overlap_ratio_ = 0.0;
     PhaseSeconds phase_seconds_;
 };

@@ -155,7 +155,7 @@ int main(int argc, char** argv)
         const int warm = 200;
         auto run = [&](int dem_steps) {
             if (n == 0)
-                for (int k = 0; k < dem_steps; ++k) bed.dem.step();
+                bed.dem.run_steps(static_cast<std::uint64_t>(dem_steps));
             else
                 for (int k = 0; k < dem_steps / n; ++k) bed.world.step();
         };
