@@ -74,6 +74,29 @@ TEST_CASE("results are bitwise repeatable for a given thread count, in single st
     }
 }
 
+TEST_CASE("a wall's reaction is the sum of its contacts, on one thread and on two", "[dem][unit]")
+{
+    // Each thread sums its share of every wall's reaction in the wall phase and the shares are added in
+    // thread order. Summed again here from the step's contact records (forces on the particles, negated),
+    // the totals agree to round-off: 1e-9 of the wall's weight-scale force. A share lost or counted twice
+    // would be off by a whole thread's part (about half the floor's load on two threads).
+    for (int threads : {1, 2}) {
+        World w = make_box_bed(threads, 0.7, 1200.0);
+        w.prepare();
+        w.run_steps(static_cast<std::uint64_t>(1.5 / w.step_s()));  // landed on the floor, against the four sides
+        std::vector<Vec3> force(5, Vec3{});
+        for (const ContactRecord& c : w.last_contact_records())
+            force[static_cast<std::size_t>(c.surface_id)] -= c.normal_world * c.normal_force_N + c.tangential_force_N;
+        const double weight = w.total_mass_kg() * 9.81;
+        CAPTURE(threads);
+        CHECK(-w.wall_force_N(0).z > 0.5 * weight);  // the floor carries the bed
+        for (int k = 0; k < 5; ++k) {
+            CAPTURE(k);
+            CHECK(norm(w.wall_force_N(k) - force[static_cast<std::size_t>(k)]) < 1e-9 * weight);
+        }
+    }
+}
+
 TEST_CASE("contact history survives neighbour-list rebuilds", "[dem][unit]")
 {
     // Settle, then run 200 steps twice: once as is, once rebuilding (and re-sorting) every step. With the
