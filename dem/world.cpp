@@ -842,7 +842,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         const std::size_t q = candidates_[k].mesh;
         const PlaneWall& pl = planes_[q];
         const double dist = dot(x, pl.normal) - plane_offset_m_[q];
-        if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, x - pl.normal * dist, pl.normal, r - dist, true, nullptr});
+        if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, kPlaneCandidate, x - pl.normal * dist, pl.normal, r - dist, true});
     }
 
     // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
@@ -852,11 +852,8 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         const double dist = std::sqrt(cp.distance_squared);
         const Vec3 point = mw.to_world(cp.point);
         const Vec3 normal = mw.rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : candidate_triangles_[q].normal);
-        std::uint32_t feature_id = mc.triangle;
-        const TriangleIds& ids = candidate_ids_[q];
-        if (cp.feature == meshes::Feature::Edge) feature_id = ids.edges[static_cast<std::size_t>(cp.local_index)];
-        if (cp.feature == meshes::Feature::Vertex) feature_id = ids.vertices[static_cast<std::size_t>(cp.local_index)];
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, feature_id, point, normal, r - dist, true, &ids});
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, cp.local_index, q, point, normal,
+                  r - dist, true});
     };
     // each mesh's triangles are tested in its body frame, with the sphere's centre moved there once per mesh
     std::uint32_t body_mesh = kPlaneCandidate;
@@ -929,23 +926,30 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
     // closest point of its neighbourhood: a convex edge or corner), and a feature shared by several
     // triangles counts once. Every triangle closer than a hit is itself a hit (it lies within r), so
     // the check over the hits is exact.
+    // A lone mesh hit has nothing to be compared with (the common case: one face of a rock). The ids of the
+    // touched features are looked up only here.
     const int hit_count = static_cast<int>(hits.size());
-    for (int a = first_mesh_hit; a < hit_count; ++a) {
+    auto feature_id = [&](const WallHit& h) {
+        const TriangleIds& ids = candidate_ids_[h.candidate];
+        const auto local = static_cast<std::size_t>(h.local_index);
+        return h.feature == meshes::Feature::Edge ? ids.edges[local] : ids.vertices[local];
+    };
+    for (int a = first_mesh_hit; a < hit_count && hit_count - first_mesh_hit > 1; ++a) {
         WallHit& h = hits[static_cast<std::size_t>(a)];
         if (h.feature == meshes::Feature::Face) continue;
         const double tolerance = 1e-9 * r;
+        const std::uint32_t id = feature_id(h);
         for (int b = first_mesh_hit; b < hit_count && h.keep; ++b) {
             const WallHit& o = hits[static_cast<std::size_t>(b)];
             if (b == a || o.wall != h.wall) continue;
-            if (o.feature == h.feature && o.feature_id == h.feature_id) {
+            if (o.feature == h.feature && feature_id(o) == id) {
                 if (b < a) h.keep = false;  // the same feature seen from another triangle: the first one stays
                 continue;
             }
-            const auto& tri = o.ids->vertices;
-            const auto& edges = o.ids->edges;
+            const TriangleIds& other = candidate_ids_[o.candidate];
             const bool shares = h.feature == meshes::Feature::Edge
-                                    ? (edges[0] == h.feature_id || edges[1] == h.feature_id || edges[2] == h.feature_id)
-                                    : (tri[0] == h.feature_id || tri[1] == h.feature_id || tri[2] == h.feature_id);
+                                    ? (other.edges[0] == id || other.edges[1] == id || other.edges[2] == id)
+                                    : (other.vertices[0] == id || other.vertices[1] == id || other.vertices[2] == id);
             if (shares && o.overlap > h.overlap + tolerance) h.keep = false;
         }
     }
@@ -958,7 +962,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
     const Vec3 w = particles_.angular_velocity_rad_per_s[i];
     for (const WallHit& h : hits) {
         if (!h.keep) continue;
-        WallContact c;
+        WallContact& c = out.emplace_back();  // filled in place: a contact is some 200 bytes
         c.particle = i;
         c.wall = h.wall;
         c.triangle = h.triangle;
@@ -981,26 +985,20 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
             c.first_step = false;
         }
 
-        const WallRef& ref = walls_[static_cast<std::size_t>(h.wall)];
-        const MaterialIndex wall_material = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].material()
-                                                        : planes_[static_cast<std::size_t>(ref.index)].material;
-        const Vec3 wall_velocity = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].velocity_at(h.point) : Vec3{};
-        const Vec3 wall_spin = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].angular_velocity_rad_per_s() : Vec3{};
-        const PairCoefficients& p = materials_.pair_unchecked(particles_.material[i], wall_material);
+        const WallMotion& wall = wall_motion_[static_cast<std::size_t>(h.wall)];
+        const PairCoefficients& p = materials_.pair_unchecked(particles_.material[i], wall.material);
         const Vec3 arm = h.point - x;
         ContactState s;
         s.overlap_m = h.overlap;
         s.normal = h.normal;
-        s.relative_velocity_m_per_s = v + cross(w, arm) - wall_velocity;
-        s.relative_angular_velocity_rad_per_s = w - wall_spin;
+        s.relative_velocity_m_per_s = v + cross(w, arm) - wall.velocity_at(h.point);
+        s.relative_angular_velocity_rad_per_s = w - wall.angular_velocity_rad_per_s;
         s.effective_radius_m = r;
-        const double wall_mass = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].mass_kg() : 0.0;
-        s.effective_mass_kg = wall_mass > 0.0 ? particles_.mass_kg[i] * wall_mass / (particles_.mass_kg[i] + wall_mass)
-                                              : particles_.mass_kg[i];
+        s.effective_mass_kg = wall.mass_kg > 0.0 ? particles_.mass_kg[i] * wall.mass_kg / (particles_.mass_kg[i] + wall.mass_kg)
+                                                 : particles_.mass_kg[i];
         s.normal_stiffness_N_per_m = wall_normal_stiffness(bulk_modulus_Pa_[particles_.material[i]], r, p.normal_stiffness_scale);
         c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
         c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
-        out.push_back(c);
     }
 }
 
@@ -1035,6 +1033,17 @@ void World::compute_wall_contacts(double dt_s)
 {
     const std::size_t n = particles_.size();
     const bool any_wall = !walls_.empty();
+    wall_motion_.resize(walls_.size());
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        const WallRef& ref = walls_[w];
+        if (ref.is_mesh) {
+            const MeshWall& mw = meshes_[static_cast<std::size_t>(ref.index)];
+            wall_motion_[w] = {mw.reference_point_m(), mw.reference_velocity_m_per_s(), mw.angular_velocity_rad_per_s(), mw.mass_kg(),
+                               mw.material()};
+        } else {
+            wall_motion_[w] = {Vec3{}, Vec3{}, Vec3{}, 0.0, planes_[static_cast<std::size_t>(ref.index)].material};
+        }
+    }
 #pragma omp parallel num_threads(threads_)
     {
         const int t = omp_get_thread_num();
@@ -1058,7 +1067,11 @@ void World::compute_wall_contacts(double dt_s)
             wall_contact_offset_.assign(static_cast<std::size_t>(threads_) + 1, 0);
             for (std::size_t q = 0; q < static_cast<std::size_t>(threads_); ++q)
                 wall_contact_offset_[q + 1] = wall_contact_offset_[q] + thread_wall_contacts_[q].size();
-            wall_contacts_.resize(wall_contact_offset_.back());
+            // one thread: its list becomes the step's as it is; more: each copies its list to its offset below
+            if (threads_ == 1)
+                wall_contacts_.swap(thread_wall_contacts_[0]);
+            else
+                wall_contacts_.resize(wall_contact_offset_.back());
             wall_contact_start_.resize(n + 1);
             wall_contact_start_[n] = static_cast<std::uint32_t>(wall_contacts_.size());
             thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));
@@ -1070,8 +1083,8 @@ void World::compute_wall_contacts(double dt_s)
             thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
         }
         std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
-        const auto& filled = thread_wall_contacts_[static_cast<std::size_t>(t)];
-        std::copy(filled.begin(), filled.end(), wall_contacts_.begin() + static_cast<std::ptrdiff_t>(k));
+        const auto& filled = threads_ == 1 ? wall_contacts_ : thread_wall_contacts_[static_cast<std::size_t>(t)];
+        if (threads_ > 1) std::copy(filled.begin(), filled.end(), wall_contacts_.begin() + static_cast<std::ptrdiff_t>(k));
         for (std::size_t i = begin; i < end; ++i) {
             wall_contact_start_[i] = static_cast<std::uint32_t>(k);
             while (k < wall_contact_offset_[static_cast<std::size_t>(t) + 1] && wall_contacts_[k].particle == i) ++k;
@@ -1089,10 +1102,8 @@ void World::compute_wall_contacts(double dt_s)
             const WallContact& c = filled[q];
             const auto w = static_cast<std::size_t>(c.wall);
             const Vec3 on_wall = -(c.normal * c.forces.normal_force_N + c.forces.tangential_force_N);
-            const WallRef& ref = walls_[w];
-            const Vec3 about = ref.is_mesh ? meshes_[static_cast<std::size_t>(ref.index)].reference_point_m() : Vec3{};
             wall_force[w] += on_wall;
-            wall_torque[w] += cross(c.point - about, on_wall) - c.forces.rolling_torque_N_m;
+            wall_torque[w] += cross(c.point - wall_motion_[w].reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
             if (first_deep == kNoContact && c.overlap_m / particles_.radius_m[c.particle] > settings_.max_overlap_ratio)
                 first_deep = offset + q;
         }

@@ -144,6 +144,17 @@ public:
 
 private:
     struct WallRef { bool is_mesh; int index; };
+    /// What a wall contact's force needs of its wall, copied at the start of each wall phase into one small
+    /// record per wall (a mesh's own object is large and spread over many cache lines).
+    struct WallMotion {
+        Vec3 reference_point_m, reference_velocity_m_per_s, angular_velocity_rad_per_s;  ///< zero for a plane
+        double mass_kg;                                                                  ///< 0: immovable
+        MaterialIndex material;
+        Vec3 velocity_at(const Vec3& point_m) const
+        {
+            return reference_velocity_m_per_s + cross(angular_velocity_rad_per_s, point_m - reference_point_m);
+        }
+    };
     struct WallContact {
         std::uint32_t particle;
         std::int32_t wall, triangle;
@@ -160,11 +171,11 @@ private:
     struct WallHit {
         std::int32_t wall, triangle;
         meshes::Feature feature;
-        std::uint32_t feature_id;
+        std::int32_t local_index;  ///< which edge or vertex of the triangle (meshes::ClosestPoint)
+        std::uint32_t candidate;   ///< the triangle's place in candidates_ (kPlaneCandidate for a plane)
         Vec3 point, normal;
         double overlap;
         bool keep;
-        const TriangleIds* ids;  ///< the triangle's vertex and edge ids beside its candidate (null for a plane)
     };
 
     void sum_wall_reactions();
@@ -197,6 +208,7 @@ private:
     std::vector<PlaneWall> planes_;
     std::vector<MeshWall> meshes_;
     std::vector<WallRef> walls_;
+    std::vector<WallMotion> wall_motion_;  ///< beside walls_, refreshed by compute_wall_contacts
     std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
     std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane

@@ -22,8 +22,53 @@ struct ClosestPoint {
     int local_index = 0;  ///< edge 0..2 (v0v1, v1v2, v2v0) or vertex 0..2 of the triangle; unused for Face
 };
 
-/// Exact closest point on triangle (a, b, c) to p, by Voronoi regions of the vertices, edges and face.
-ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+/// Exact closest point on triangle (a, b, c) to p, by Voronoi regions of the vertices, edges and face
+/// (Ericson, Real-Time Collision Detection (2005), §5.1.5). Inline: the sphere-wall search calls it in its
+/// inner loop.
+inline ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
+{
+    ClosestPoint out;
+    const Vec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    auto finish = [&](const Vec3& q, Feature f, int index) {
+        out.point = q;
+        out.distance_squared = norm_squared(p - q);
+        out.feature = f;
+        out.local_index = index;
+        return out;
+    };
+    if (d1 <= 0.0 && d2 <= 0.0) return finish(a, Feature::Vertex, 0);
+
+    const Vec3 bp = p - b;
+    const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) return finish(b, Feature::Vertex, 1);
+
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        const double v = d1 / (d1 - d3);
+        return finish(a + ab * v, Feature::Edge, 0);
+    }
+
+    const Vec3 cp = p - c;
+    const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) return finish(c, Feature::Vertex, 2);
+
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        const double w = d2 / (d2 - d6);
+        return finish(a + ac * w, Feature::Edge, 2);
+    }
+
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return finish(b + (c - b) * w, Feature::Edge, 1);
+    }
+
+    const double denom = 1.0 / (va + vb + vc);
+    const double v = vb * denom, w = vc * denom;
+    return finish(a + ab * v + ac * w, Feature::Face, 0);
+}
 
 /// A triangle surface mesh in its own (body) frame. Vertices are shared between triangles; edges are
 /// numbered once however many triangles share them, so that contacts can be made unique per feature.
