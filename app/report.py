@@ -158,6 +158,28 @@ try:
             fig.savefig(os.path.join(folder, "mass_per_pass.png"))
             plt.close(fig)
             figures.append(("Mass per pass", "mass_per_pass.png"))
+    fit = summary.get("repose_fit")
+    if fit:
+        # the pile's surface as the repose probe read it at the end, and the line fitted to its slope
+        along, surface, fitted = fit["bin_centre_m"], fit["surface_m"], fit["fitted"]
+        fig, ax = plt.subplots(figsize=(7, 3.6), dpi=110)
+        ax.plot([s for s, f in zip(along, fitted) if not f], [z for z, f in zip(surface, fitted) if not f], "o",
+                markersize=3, color="0.6", label="top of a bin, off the slope")
+        ax.plot([s for s, f in zip(along, fitted) if f], [z for z, f in zip(surface, fitted) if f], "o",
+                markersize=3, color="tab:brown", label="top of a bin on the slope (fitted)")
+        ends = [min(s for s, f in zip(along, fitted) if f), max(s for s, f in zip(along, fitted) if f)]
+        ax.plot(ends, [fit["intercept_m"] + fit["slope"] * s for s in ends], color="tab:blue", linewidth=1.5,
+                label=f"fitted line: {summary['repose_angle_deg']:.1f}°")
+        ax.set_xlabel(f"{fit['along']} [m]")
+        ax.set_ylabel("surface height [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title("Pile surface at the end and the angle of repose")
+        fig.tight_layout()
+        fig.savefig(os.path.join(folder, "repose.png"))
+        plt.close(fig)
+        figures.append(("Pile surface at the end and the angle of repose", "repose.png"))
     note = ""
 except ImportError:
     note = "matplotlib is not installed (Debian: python3-matplotlib), so this report has no figures.\n"
@@ -181,6 +203,10 @@ for wall, f in summary["wall_forces_N"].items():
     lines.append(f"| force on {wall} | ({g(f[0], 1e-3)}, {g(f[1], 1e-3)}, {g(f[2], 1e-3)}) kN |")
 for region, m in summary["region_mass_kg"].items():
     lines.append(f"| mass in {region} | {g(m)} kg |")
+if "repose_angle_deg" in summary:
+    fit = summary.get("repose_fit")
+    detail = f" (line through {sum(fit['fitted'])} bins, rms residual {g(fit['rms_residual_m'])} m)" if fit else " (no slope in the window)"
+    lines.append(f"| angle of repose | {g(summary['repose_angle_deg'])}°{detail} |")
 if "passes" in summary:
     lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] "
               "| mean interface force over the dig [MN] | peak [MN] |",

@@ -21,7 +21,8 @@ void ReposeWindow::validate(const std::string& where) const
     if ((max_m[axis] - min_m[axis]) / bin_m > 1e6) throw InputError(concat(where, ": more than a million bins; use a larger bin_m"));
 }
 
-ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const std::string& where)
+ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const std::string& where,
+                           const std::vector<Vec3>& surface_points)
 {
     w.validate(where);
     const int axis = w.along == 'x' ? 0 : 1;
@@ -33,6 +34,11 @@ ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const 
         if (x.x < w.min_m.x || x.y < w.min_m.y || x.z < w.min_m.z || x.x > w.max_m.x || x.y > w.max_m.y || x.z > w.max_m.z) continue;
         const auto b = std::min(bins - 1, static_cast<std::size_t>((x[axis] - lo) / w.bin_m));
         top[b] = std::max(top[b], x.z + p.radius_m[i]);
+    }
+    for (const Vec3& x : surface_points) {
+        if (x.x < w.min_m.x || x.y < w.min_m.y || x.z < w.min_m.z || x.x > w.max_m.x || x.y > w.max_m.y || x.z > w.max_m.z) continue;
+        const auto b = std::min(bins - 1, static_cast<std::size_t>((x[axis] - lo) / w.bin_m));
+        top[b] = std::max(top[b], x.z);
     }
     ReposeFit fit;
     double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
@@ -49,9 +55,11 @@ ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const 
     // least squares over the bins on the slope
     const double z_lo = zmin + w.low_fraction * (zmax - zmin), z_hi = zmin + w.high_fraction * (zmax - zmin);
     double n = 0, ss = 0, sz = 0, sss = 0, ssz = 0;
+    fit.fitted.assign(fit.surface_m.size(), false);
     for (std::size_t k = 0; k < fit.surface_m.size(); ++k) {
         const double s = fit.bin_centre_m[k], z = fit.surface_m[k];
         if (z < z_lo || z > z_hi) continue;
+        fit.fitted[k] = true;
         n += 1;
         ss += s;
         sz += z;
@@ -61,13 +69,14 @@ ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const 
     fit.bins_fitted = static_cast<int>(n);
     if (n < 3 || !(n * sss - ss * ss > 0.0))
         throw InputError(concat(where, ": only ", fit.bins_fitted, " bins lie on the slope (of ", fit.surface_m.size(),
-                                " with particles); the window holds no pile slope to fit"));
+                                " with particles or surface points); the window holds no pile slope to fit"));
     fit.slope = (n * ssz - ss * sz) / (n * sss - ss * ss);
     const double a = (sz - fit.slope * ss) / n;
+    fit.intercept_m = a;
     double r2 = 0.0;
     for (std::size_t k = 0; k < fit.surface_m.size(); ++k) {
         const double z = fit.surface_m[k];
-        if (z < z_lo || z > z_hi) continue;
+        if (!fit.fitted[k]) continue;
         const double e = z - (a + fit.slope * fit.bin_centre_m[k]);
         r2 += e * e;
     }

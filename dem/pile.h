@@ -25,13 +25,19 @@ struct ReposeWindow {
 struct ReposeFit {
     double angle_deg = 0.0;       ///< atan of the fitted slope's magnitude
     double slope = 0.0;           ///< dz / d(along), signed
+    double intercept_m = 0.0;     ///< the fitted line is z = intercept_m + slope * along
     double rms_residual_m = 0.0;  ///< of the fitted bins about the line
     int bins_fitted = 0;
     std::vector<double> bin_centre_m, surface_m;  ///< every non-empty bin: its centre and surface height
+    std::vector<bool> fitted;                     ///< beside them: whether the bin is on the slope, in the fit
 };
 
 /// The method (docs/results.md): bin, take each bin's top, keep the bins on the slope, least-squares line
 /// z = a + b s, angle = atan |b|. Throws InputError naming `where` if fewer than 3 bins are on the slope.
-ReposeFit fit_repose_angle(const ParticleStore& particles, const ReposeWindow& window, const std::string& where);
+/// `surface_points` are points on the surfaces of other bodies of the pile, such as the hull vertices of
+/// rocks in world coordinates. Each one inside the window raises its bin's top to its height. A rock's
+/// highest point over a bin is one of its vertices, or lies on an edge that crosses the bin's border.
+ReposeFit fit_repose_angle(const ParticleStore& particles, const ReposeWindow& window, const std::string& where,
+                           const std::vector<Vec3>& surface_points = {});
 
 }  // namespace dipper::dem

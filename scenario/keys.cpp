@@ -132,10 +132,10 @@ const std::vector<KeySpec>& scenario_keys()
         {"probes.regions[].min_m", "vector3", "required", "lower corner"},
         {"probes.regions[].max_m", "vector3", "required", "upper corner"},
         {"probes.repose", "map", "none", "angle of repose: a line fitted to the pile surface in a window (column repose_angle_deg)"},
-        {"probes.repose.min_m", "vector3", "required", "lower corner of the window (particles by centre)"},
+        {"probes.repose.min_m", "vector3", "required", "lower corner of the window (spheres by centre, rocks by vertex)"},
         {"probes.repose.max_m", "vector3", "required", "upper corner of the window"},
         {"probes.repose.along", "string", "x", "x or y: the direction the slope runs in"},
-        {"probes.repose.bin_m", "number", "0.2", "bin width along the slope; each bin's surface is its highest sphere top"},
+        {"probes.repose.bin_m", "number", "0.2", "bin width along the slope; each bin's surface is its highest sphere top or rock vertex"},
 
         {"output", "map", "{}", "what is written, and how often"},
         {"output.vtk_interval_s", "number", "0.1", "simulated seconds between ParaView snapshots; 0: first and last only"},

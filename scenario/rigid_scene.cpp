@@ -486,6 +486,16 @@ bool RigidScene::is_rock_wall(int wall) const
     return wall >= static_cast<int>(scenario_walls_) && wall != dipper_wall_ && wall != door_wall_;
 }
 
+std::vector<Vec3> RigidScene::rock_surface_points() const
+{
+    std::vector<Vec3> points;
+    for (const coupling::RockRecord& rock : coupled_->rocks()) {
+        const rigid::BodyState st = rigid_->state(rock.body);
+        for (const Vec3& v : rock.shape.vertices_m()) points.push_back(st.rotation * v + st.position_m);
+    }
+    return points;
+}
+
 void RigidScene::write_rocks_vtp(const std::string& path) const
 {
     std::vector<Vec3> x;

@@ -110,6 +110,8 @@ public:
     /// Every rock as one ParaView surface: triangles of each hull with cell fields rock (index),
     /// speed_m_per_s and size_m.
     void write_rocks_vtp(const std::string& path) const;
+    /// Every rock's hull vertices where the rock is now (world frame): the rocks' part of a pile's surface.
+    std::vector<Vec3> rock_surface_points() const;
     double rock_kinetic_energy_J() const { return rigid_->kinetic_energy_J(); }
 
     /// Throws SimulationError naming the rock, where and when, if a rock's centre lies inside the steel

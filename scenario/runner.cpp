@@ -16,7 +16,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numeric>
+#include <optional>
 #include <unistd.h>
 
 namespace dipper::scenario {
@@ -329,14 +331,22 @@ private:
         return mass;
     }
 
+    /// The repose probe's fit now, from the spheres and the rocks on the pile's surface; empty while the
+    /// window holds no slope to fit.
+    std::optional<dem::ReposeFit> repose_fit() const
+    {
+        try {
+            return dem::fit_repose_angle(world_->particles(), scenario_.repose->window, scenario_.repose->where,
+                                         rigid_ ? rigid_->rock_surface_points() : std::vector<Vec3>{});
+        } catch (const InputError&) {
+            return std::nullopt;
+        }
+    }
     /// The repose probe's angle now; NaN while the window holds no slope to fit.
     double repose_angle_deg() const
     {
-        try {
-            return dem::fit_repose_angle(world_->particles(), scenario_.repose->window, scenario_.repose->where).angle_deg;
-        } catch (const InputError&) {
-            return std::numeric_limits<double>::quiet_NaN();
-        }
+        const std::optional<dem::ReposeFit> fit = repose_fit();
+        return fit ? fit->angle_deg : std::numeric_limits<double>::quiet_NaN();
     }
 
     void write_row()
@@ -561,7 +571,31 @@ private:
         for (std::size_t k = 0; k < scenario_.regions.size(); ++k)
             out << (k ? ", " : "") << "\"" << json_escape(scenario_.regions[k].name) << "\": " << json_number(region_mass_kg(scenario_.regions[k]));
         out << "}";
-        if (scenario_.repose) out << ",\n  \"repose_angle_deg\": " << json_number(repose_angle_deg());
+        if (scenario_.repose) {
+            // the angle and the surface it was fitted to: each bin's centre along the slope, its top, and
+            // whether it lies on the slope (in the fit); null while there is no slope
+            const std::optional<dem::ReposeFit> fit = repose_fit();
+            out << ",\n  \"repose_angle_deg\": " << json_number(fit ? fit->angle_deg : std::numeric_limits<double>::quiet_NaN())
+                << ",\n  \"repose_fit\": ";
+            if (fit) {
+                auto list = [&](const auto& values) {
+                    out << '[';
+                    for (std::size_t k = 0; k < values.size(); ++k) out << (k ? ", " : "") << json_number(static_cast<double>(values[k]));
+                    out << ']';
+                };
+                out << "{\"slope\": " << json_number(fit->slope) << ", \"intercept_m\": " << json_number(fit->intercept_m)
+                    << ", \"rms_residual_m\": " << json_number(fit->rms_residual_m) << ", \"along\": \"" << scenario_.repose->window.along
+                    << "\",\n    \"bin_centre_m\": ";
+                list(fit->bin_centre_m);
+                out << ",\n    \"surface_m\": ";
+                list(fit->surface_m);
+                out << ",\n    \"fitted\": ";
+                list(fit->fitted);
+                out << '}';
+            } else {
+                out << "null";
+            }
+        }
         if (!scenario_.pile.empty())
             out << ",\n  \"pile\": {\"spheres\": " << pile_.spheres << ", \"rocks\": " << pile_.rocks << ", \"spheres_left_out\": "
                 << pile_.spheres_left_out << ", \"rocks_left_out\": " << pile_.rocks_left_out << "}";

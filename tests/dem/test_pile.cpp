@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -50,6 +51,11 @@ TEST_CASE("the repose fit finds the slope of a pile of known angle and ignores i
         CHECK(fit.slope < 0.0);  // downhill along +x
         CHECK(fit.bins_fitted >= 8);
         CHECK(fit.rms_residual_m < 0.05);
+        // the line, and which bins made it: the flags count the fitted bins, and the line passes through
+        // the slope's top corner (x 0.5 m, z 1.5 m) within the bins' scatter (tan(angle) x 0.1 m, 0.1 m)
+        CHECK(std::count(fit.fitted.begin(), fit.fitted.end(), true) == fit.bins_fitted);
+        CHECK(fit.fitted.size() == fit.surface_m.size());
+        CHECK(fit.intercept_m + fit.slope * 0.5 == Approx(1.5).margin(0.1));
     }
 }
 
@@ -66,4 +72,45 @@ TEST_CASE("the repose fit refuses a window without a slope and a bad window", "[
     bad = flat;
     bad.max_m.x = 3.0;
     CHECK_THROWS_WITH(fit_repose_angle(w.particles(), bad, "window"), Catch::Contains("max_m must exceed min_m"));
+}
+
+TEST_CASE("the repose fit reads the surface of rocks from their hull points", "[dem][pile]")
+{
+    ReposeWindow window;
+    window.min_m = {0.0, 0.0, 0.0};
+    window.max_m = {5.0, 1.0, 3.0};
+    window.bin_m = 0.1;
+    // The points of a pile surface at 34.7 deg, one every 2 cm along x, like the vertices of rocks lying
+    // on it, with points below them (the rocks' lower vertices).
+    const double angle = 34.7, t = std::tan(angle * M_PI / 180.0);
+    std::vector<Vec3> points;
+    for (double x = 0.0; x < 5.0; x += 0.02) {
+        const double surface = std::clamp(1.5 - t * (x - 0.5), 0.1, 1.5);
+        points.push_back({x, 0.5, surface});
+        points.push_back({x, 0.3, 0.5 * surface});
+    }
+    points.push_back({2.0, 0.5, 3.5});  // above the window: not part of it
+
+    SECTION("rocks alone")
+    {
+        const World none(MaterialTable::aitik_copper_ore(), WorldSettings{});
+        const ReposeFit fit = fit_repose_angle(none.particles(), window, "rocks", points);
+        // every bin's top lies on the surface within one 2 cm point spacing: tan(34.7) x 0.02 m = 14 mm
+        // at most, over 20+ bins; 0.3 deg.
+        CHECK(fit.angle_deg == Approx(angle).margin(0.3));
+        CHECK(fit.bins_fitted >= 10);
+    }
+    SECTION("rocks lying on top of a lower pile of spheres set the surface")
+    {
+        const World spheres = synthetic_pile(20.0, 3);
+        CHECK(fit_repose_angle(spheres.particles(), window, "spheres").angle_deg == Approx(20.0).margin(0.5));
+        // rocks on a 34.7 deg slope with the spheres' toe (x = 0.5 + 1.4 / tan 20 deg) and a top at 2.9 m:
+        // steeper through the same toe, they lie above the spheres' surface everywhere up the slope
+        const double toe = 0.5 + 1.4 / std::tan(20.0 * M_PI / 180.0);
+        std::vector<Vec3> rocks;
+        for (double x = 0.0; x < 5.0; x += 0.02) rocks.push_back({x, 0.5, std::clamp(0.1 + t * (toe - x), 0.1, 2.9)});
+        const ReposeFit fit = fit_repose_angle(spheres.particles(), window, "spheres and rocks", rocks);
+        // as for the rocks alone; 0.3 deg
+        CHECK(fit.angle_deg == Approx(angle).margin(0.3));
+    }
 }

@@ -106,6 +106,9 @@ TEST_CASE("dipper's repose calibration runs the scenario and writes its table", 
                Catch::StartsWith("run,friction,rolling_friction,repose_angle_deg,angle_sd_deg,seed_angles_deg\n0,0.2,0.05,"));
     for (const char* run : {"run_000_seed_0", "run_000_seed_1", "run_001_seed_0", "run_001_seed_1"})
         CHECK(fs::exists(dir + "/" + run + "/summary.json"));
+    // each run's summary has the surface the angle was fitted to, for its report's figure
+    CHECK_THAT(test::read_text_file(dir + "/run_000_seed_0/summary.json"),
+               Catch::Contains("\"repose_fit\": {\"slope\": ") && Catch::Contains("\"surface_m\": [") && Catch::Contains("\"fitted\": ["));
     CHECK_THAT(test::read_text_file(dir + "/run_000_seed_1/scenario.yaml"), Catch::Contains("seed: 6"));
 
     CHECK_THROWS_WITH(calibrate_repose(std::string(DIPPER_SOURCE_DIR) + "/tests/data/scenarios/repose_small.yaml", "ore", "rock", s, dir, o),
