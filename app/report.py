@@ -205,8 +205,11 @@ for region, m in summary["region_mass_kg"].items():
     lines.append(f"| mass in {region} | {g(m)} kg |")
 if "repose_angle_deg" in summary:
     fit = summary.get("repose_fit")
-    detail = f" (line through {sum(fit['fitted'])} bins, rms residual {g(fit['rms_residual_m'])} m)" if fit else " (no slope in the window)"
-    lines.append(f"| angle of repose | {g(summary['repose_angle_deg'])}°{detail} |")
+    if fit:
+        lines.append(f"| angle of repose | {g(summary['repose_angle_deg'])}° (line through {sum(fit['fitted'])} bins, "
+                     f"rms residual {g(fit['rms_residual_m'])} m) |")
+    else:
+        lines.append("| angle of repose | none: no pile slope in the probe's window |")
 if "passes" in summary:
     lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] "
               "| mean interface force over the dig [MN] | peak [MN] |",

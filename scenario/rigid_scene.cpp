@@ -498,20 +498,20 @@ std::vector<Vec3> RigidScene::rock_surface_points() const
 
 void RigidScene::write_rocks_vtp(const std::string& path) const
 {
-    std::vector<Vec3> x;
+    const std::vector<Vec3> x = rock_surface_points();  // each rock's vertices in turn
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<double> index, speed, size;
+    std::uint32_t first = 0;
     for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
         const coupling::RockRecord& rock = coupled_->rocks()[k];
         const rigid::BodyState st = rigid_->state(rock.body);
-        const auto first = static_cast<std::uint32_t>(x.size());
-        for (const Vec3& v : rock.shape.vertices_m()) x.push_back(st.rotation * v + st.position_m);
         for (const auto& t : rock.shape.triangles()) {
             triangles.push_back({first + t[0], first + t[1], first + t[2]});
             index.push_back(static_cast<double>(k));
             speed.push_back(norm(st.velocity_m_per_s));
             size.push_back(rock.shape.equivalent_diameter_m());
         }
+        first += static_cast<std::uint32_t>(rock.shape.vertices_m().size());
     }
     meshes::write_surface_vtp(path, x, triangles, {}, {{"rock", index}, {"speed_m_per_s", speed}, {"size_m", size}});
 }
