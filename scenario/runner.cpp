@@ -558,7 +558,7 @@ private:
         out << "{\n  \"name\": \"" << json_escape(scenario_.name) << "\",\n  \"status\": \"" << status << "\",\n"
             << "  \"message\": \"" << json_escape(result.message) << "\",\n"
             << "  \"time_s\": " << json_number(w.time_s()) << ",\n  \"duration_s\": " << scenario_.duration_s << ",\n"
-            << "  \"steps\": " << w.step_count() << ",\n  \"step_s\": " << w.step_s() << ",\n"
+            << "  \"steps\": " << w.step_count() << ",\n  \"step_s\": " << json_number(w.step_s()) << ",\n"
             << "  \"threads\": " << w.threads() << ",\n  \"particles\": " << w.particles().size() << ",\n"
             << "  \"mass_kg\": " << json_number(w.total_mass_kg()) << ",\n  \"kinetic_energy_J\": " << json_number(w.kinetic_energy_J()) << ",\n"
             << "  \"wall_forces_N\": {";

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -531,12 +532,23 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     }
     if (s.fills.empty() && s.pours.empty() && s.pile.empty())
         throw InputError(concat(s.source, ": the scenario has no particles; add a 'fills', 'pours' or 'pile' entry"));
-    if (s.fills.empty() && s.pile.empty() && s.step_s == 0.0) {
+    // the default time step comes from the spheres present at t = 0 (fills, pile, a pour starting at 0)
+    const auto has_spheres = [](const FillSpec& f) {
+        for (const auto& c : f.sizes.classes)
+            if (c.mass_fraction > 0.0) return true;
+        return false;
+    };
+    if (s.pile.empty() && s.step_s == 0.0 && std::none_of(s.fills.begin(), s.fills.end(), has_spheres)) {
         double first_s = std::numeric_limits<double>::infinity();
         for (const PourSpec& p : s.pours) first_s = std::min(first_s, p.start_s);
-        if (first_s > 0.0)
+        if (first_s > 0.0 && !s.pours.empty() && s.fills.empty())
             throw InputError(concat(s.pours.front().where, ": no particle exists before the first pour starts at t = ", first_s,
                                     " s, so the default time step cannot be derived; set time.step_s or let a pour start at 0"));
+        if (first_s > 0.0)
+            throw InputError(concat(s.fills.front().where, ": the fills hold rocks but no spheres (the sphere class's mass_fraction is 0)",
+                                    first_s < std::numeric_limits<double>::infinity() ? concat(" before the first pour starts at t = ", first_s, " s") : std::string(),
+                                    ", so the default time step, which comes from the spheres, cannot be derived; set time.step_s "
+                                    "(for rocks alone, e.g. 2e-4 s: Bullet then steps 1e-3 s with coupling.substeps 5)"));
     }
 
     const MapReader coupling = top.map("coupling");

@@ -160,6 +160,48 @@ TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the
     CHECK_THAT(e, Catch::Contains("fills[1].sizes: got 2 sphere classes; expected one sphere class"));
 }
 
+TEST_CASE("a fill of rocks alone needs time.step_s, and then runs: the rocks fall and come to rest", "[scenario][shovel]")
+{
+    // the thesis calibrated its rocks apart from its spheres: a fill whose sphere class holds no mass
+    const std::string text = R"(dipper_scenario: 1
+name: rocks_alone
+threads: 1
+time: {duration_s: 3.5}
+planes:
+  - {name: ground, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+fills:
+  - mass_kg: 3000
+    box: {min_m: [0, 0, 0.2], max_m: [2, 2, 1.4]}
+    sizes: [{radius_m: 0.1, mass_fraction: 0}]
+    rocks: [{size_m: 0.4, mass_fraction: 1}]
+output: {vtk_interval_s: 0, csv_interval_s: 0.5}
+)";
+    // no sphere to derive the default step from: said, with the key to set and not a run of zero steps
+    CHECK_THAT(error_of(text), Catch::Contains("case.yaml:8:14: fills[0]") && Catch::Contains("rocks but no spheres") &&
+                                   Catch::Contains("set time.step_s"));
+    const std::string with_step = std::regex_replace(text, std::regex("duration_s: 3.5"), "duration_s: 3.5, step_s: 2.0e-4");
+    const Scenario s = parse_scenario(with_step, "case.yaml", ".");
+    const fs::path dir = fs::temp_directory_path() / "dipper_rocks_alone";
+    fs::remove_all(dir);
+    RunOptions o;
+    o.progress = false;
+    const RunResult r = run_scenario(s, dir.string(), o);
+    REQUIRE(r.status == RunStatus::completed);
+    CHECK(r.steps == 17500);  // 3.5 s of 2e-4 s steps
+    const std::string summary = test::read_text_file((dir / "summary.json").string());
+    CHECK_THAT(summary, Catch::Contains("\"particles\": 0") && Catch::Contains("\"step_s\": 0.0002"));
+    // 3 t of 400 mm rocks (24 of them) dropped from up to 1.4 m: 6.9 kJ of motion at 0.25 s, at rest by 3 s
+    const std::smatch m = [&] {
+        std::smatch found;
+        std::regex_search(summary, found, std::regex("\"rocks\": ([0-9]+),\n  \"rock_kinetic_energy_J\": ([0-9.e+-]+)"));
+        return found;
+    }();
+    REQUIRE(m.size() == 3);
+    CHECK(std::stoi(m[1].str()) == 24);  // 3000 kg / (3700 kg/m3 x pi/6 x 0.4^3 m3) = 24.2
+    CHECK(std::stod(m[2].str()) < 5.0);  // under 0.1 % of the motion at 0.25 s (0.001 J at 3.5 s in a run of this scenario)
+    fs::remove_all(dir);
+}
+
 TEST_CASE("rocks and walls the rigid world cannot hold are refused with the wall named", "[scenario][shovel]")
 {
     const std::string mixed = "  - mass_kg: 3000\n    box: {min_m: [0, 0, 0], max_m: [3, 3, 3]}\n"
