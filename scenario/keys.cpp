@@ -36,6 +36,11 @@ const std::vector<KeySpec>& scenario_keys()
         {"materials.pairs[].rolling_friction", "number", "0", "rolling friction mu_roll (eq. 8)"},
         {"materials.pairs[].normal_damping_ratio", "number", "1", "D_n, fraction of critical damping (eq. 6)"},
         {"materials.pairs[].tangential_damping_ratio", "number", "1", "D_t, fraction of critical damping"},
+        {"materials.rock_pairs", "list", "[]", "coefficients of the rocks in Bullet (rock against rock or a wall), set or "
+                                              "changed; the preset: rock 0.85, ground 0.9, bucket 0.53, truck 0.85, steel 0, restitution 0"},
+        {"materials.rock_pairs[].materials", "list", "required", "rock and the other rigid material: rock, ground, bucket, truck or steel"},
+        {"materials.rock_pairs[].friction", "number", "required", "Coulomb friction mu of the pair, 0 to 2"},
+        {"materials.rock_pairs[].restitution", "number", "0", "restitution of the pair's impacts, 0 to 1"},
 
         {"planes", "list", "[]", "infinite static walls"},
         {"planes[].name", "string", "required", "unique wall name (used in outputs)"},

@@ -60,6 +60,7 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
     rigid_->add_material("steel");
     rigid_->set_pair("rock", "truck", 0.85, 0.0);
     rigid_->set_pair("rock", "steel", 0.0, 0.0);
+    for (const RockPairSpec& p : s.rock_pairs) rigid_->set_pair(p.a, p.b, p.friction, p.restitution);
     coupled_ = std::make_unique<coupling::CoupledWorld>(dem, *rigid_, coupling::CouplingSettings{s.coupling_substeps});
     bool rocks = false;
     for (const FillSpec& f : s.fills) rocks = rocks || !f.rocks.empty();

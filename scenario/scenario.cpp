@@ -331,6 +331,19 @@ void read_materials(const MapReader& top, Scenario& s)
         set("tangential_damping_ratio", c.tangential_damping_ratio);
         s.materials.set_pair(ia, ib, c, p.where("materials"));
     }
+    for (const MapReader& p : m.maps("rock_pairs")) {
+        const std::vector<std::string> names = p.texts("materials");
+        const auto rigid = [](const std::string& n) {
+            return n == "rock" || n == "ground" || n == "bucket" || n == "truck" || n == "steel";
+        };
+        if (names.size() != 2 || !rigid(names[0]) || !rigid(names[1]) || (names[0] != "rock" && names[1] != "rock"))
+            p.fail("materials", concat("[", joined(names), "]"),
+                   "[rock, X] with X one of the rigid materials rock, ground, bucket, truck, steel");
+        RockPairSpec pair{names[0], names[1], p.number("friction"), p.number("restitution")};
+        require_in_range(pair.friction, 0.0, 2.0, "friction", p.where("friction"));
+        require_in_range(pair.restitution, 0.0, 1.0, "restitution", p.where("restitution"));
+        s.rock_pairs.push_back(pair);
+    }
 }
 
 std::string material_known(const Scenario& s, const MapReader& r, const std::string& key, bool surface)

@@ -59,6 +59,12 @@ struct PourSpec : ParticleSource {
     double start_s = 0.0;  ///< nothing enters before this time
 };
 
+/// Friction and restitution of rocks against rocks or a rigid wall material (Bullet), over the preset's.
+struct RockPairSpec {
+    std::string a, b;
+    double friction = 0.0, restitution = 0.0;
+};
+
 struct RegionProbe {
     std::string name;
     Vec3 min_m, max_m;
@@ -123,6 +129,7 @@ struct Scenario {
     Vec3 gravity_m_per_s2{0.0, 0.0, -9.81};
     double duration_s = 0.0, step_s = 0.0;
     dem::MaterialTable materials;
+    std::vector<RockPairSpec> rock_pairs;  ///< applied in this order after the rigid preset
     std::vector<PlaneSpec> planes;
     std::vector<MeshSpec> meshes;
     std::string pile;  ///< a saved pile to start from (absolute path), or empty

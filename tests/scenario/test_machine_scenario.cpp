@@ -202,6 +202,37 @@ output: {vtk_interval_s: 0, csv_interval_s: 0.5}
     fs::remove_all(dir);
 }
 
+TEST_CASE("materials.rock_pairs set the rocks' coefficients in Bullet over the preset's, and bad pairs are refused",
+          "[scenario][shovel]")
+{
+    const std::string mixed = "  - mass_kg: 3000\n    box: {min_m: [0, 0, 0], max_m: [3, 3, 3]}\n"
+                              "    sizes: [{radius_m: 0.1, mass_fraction: 0.5}]\n    rocks: [{size_m: 0.5, mass_fraction: 0.5}]\n";
+    const std::string pairs = "materials:\n  rock_pairs:\n    - {materials: [rock, rock], friction: 1.1}\n"
+                              "    - {materials: [ground, rock], friction: 0.3, restitution: 0.2}\n";
+    const Scenario s = parse_scenario(base(mixed + pairs), "case.yaml", ".");
+    REQUIRE(s.rock_pairs.size() == 2);
+    auto dem = build_world(s);
+    RigidScene scene(s, *dem);
+    const rigid::RigidWorld& w = scene.rigid();
+    const int rock = w.material_index("rock"), ground = w.material_index("ground"), bucket = w.material_index("bucket");
+    CHECK(w.pair_friction(rock, rock) == 1.1);
+    CHECK(w.pair_restitution(rock, rock) == 0.0);  // the key's default
+    CHECK(w.pair_friction(rock, ground) == 0.3);
+    CHECK(w.pair_restitution(ground, rock) == 0.2);
+    CHECK(w.pair_friction(rock, bucket) == 0.53);  // not named: Table 2's value stays
+
+    std::string e = error_of(base(mixed + std::regex_replace(pairs, std::regex("\\[ground, rock\\]"), "[ground, bucket]")));
+    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[1].materials: got [ground, bucket]; expected [rock, X]"));
+    e = error_of(base(mixed + std::regex_replace(pairs, std::regex("\\[rock, rock\\]"), "[rock, ore]")));
+    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[0].materials: got [rock, ore]"));
+    e = error_of(base(mixed + std::regex_replace(pairs, std::regex("friction: 1.1"), "friction: -0.1")));
+    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[0].friction") && Catch::Contains("-0.1"));
+    e = error_of(base(mixed + std::regex_replace(pairs, std::regex("restitution: 0.2"), "restitution: 1.5")));
+    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[1].restitution") && Catch::Contains("1.5"));
+    e = error_of(base(mixed + "materials:\n  rock_pairs:\n    - {materials: [rock, rock]}\n"));
+    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[0].friction: got nothing"));
+}
+
 TEST_CASE("rocks and walls the rigid world cannot hold are refused with the wall named", "[scenario][shovel]")
 {
     const std::string mixed = "  - mass_kg: 3000\n    box: {min_m: [0, 0, 0], max_m: [3, 3, 3]}\n"
