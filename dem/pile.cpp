@@ -52,13 +52,27 @@ ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const 
     if (!(zmax - zmin >= w.bin_m))
         throw InputError(concat(where, ": the surface in the window spans ", std::isfinite(zmax - zmin) ? zmax - zmin : 0.0,
                                 " m in height, less than one bin (", w.bin_m, " m): no bins lie on the slope of a pile"));
-    // least squares over the bins on the slope
+    // The slope: the longest run of neighbouring bins whose tops lie in the band between the flat top and
+    // the toe. A bin in the band but cut off from that run by one outside it is not on the slope: a rock
+    // rolled out past the toe, or a hump on the crest.
     const double z_lo = zmin + w.low_fraction * (zmax - zmin), z_hi = zmin + w.high_fraction * (zmax - zmin);
+    std::size_t best_first = 0, best_count = 0;
+    for (std::size_t k = 0; k < fit.surface_m.size();) {
+        std::size_t end = k;
+        while (end < fit.surface_m.size() && fit.surface_m[end] >= z_lo && fit.surface_m[end] <= z_hi &&
+               (end == k || fit.bin_centre_m[end] - fit.bin_centre_m[end - 1] < 1.5 * w.bin_m))
+            ++end;
+        if (end - k > best_count) {
+            best_first = k;
+            best_count = end - k;
+        }
+        k = end > k ? end : k + 1;
+    }
+    // least squares over the bins on the slope
     double n = 0, ss = 0, sz = 0, sss = 0, ssz = 0;
     fit.fitted.assign(fit.surface_m.size(), false);
-    for (std::size_t k = 0; k < fit.surface_m.size(); ++k) {
+    for (std::size_t k = best_first; k < best_first + best_count; ++k) {
         const double s = fit.bin_centre_m[k], z = fit.surface_m[k];
-        if (z < z_lo || z > z_hi) continue;
         fit.fitted[k] = true;
         n += 1;
         ss += s;

@@ -114,3 +114,26 @@ TEST_CASE("the repose fit reads the surface of rocks from their hull points", "[
         CHECK(fit.angle_deg == Approx(angle).margin(0.3));
     }
 }
+
+TEST_CASE("the repose fit takes the slope as one run of bins: rocks rolled out past the toe are left out", "[dem][pile]")
+{
+    ReposeWindow window;
+    window.min_m = {0.0, 0.0, 0.0};
+    window.max_m = {6.0, 1.0, 3.0};
+    window.bin_m = 0.1;
+    const World w = synthetic_pile(34.7, 5);  // top 1.5 m to x = 0.5, toe at x = 2.5, run-out at 0.1 m
+    const ReposeFit alone = fit_repose_angle(w.particles(), window, "pile");
+    REQUIRE(alone.angle_deg == Approx(34.7).margin(0.5));
+    // Two large rocks rolled out to x 4-4.3 and 5.2-5.4, 0.45 m high: above the band's low edge (0.1 +
+    // 0.15 x 1.4 = 0.31 m), but cut off from the slope by the run-out between
+    std::vector<Vec3> rocks;
+    for (double x = 4.0; x < 4.3; x += 0.02) rocks.push_back({x, 0.5, 0.45});
+    for (double x = 5.2; x < 5.4; x += 0.02) rocks.push_back({x, 0.5, 0.45});
+    const ReposeFit with = fit_repose_angle(w.particles(), window, "pile and rolled-out rocks", rocks);
+    // the same bins as without the rocks, so the same line to round-off; every bin in the band, as the fit
+    // took them before, reads 8.6 deg
+    CHECK(with.angle_deg == Approx(alone.angle_deg).margin(1e-9));
+    CHECK(with.bins_fitted == alone.bins_fitted);
+    for (std::size_t k = 0; k < with.bin_centre_m.size(); ++k)
+        if (with.bin_centre_m[k] > 3.5) CHECK_FALSE(with.fitted[k]);
+}
