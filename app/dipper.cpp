@@ -237,7 +237,7 @@ int main(int argc, char** argv)
             for (const std::string& file : o.positional) {
                 if (is_sweep_file(file)) {
                     const Sweep sw = load_sweep(file);  // every variant is parsed and checked
-                    std::printf("%s: ok: sweep of %zu variants\n", file.c_str(), sw.variants().size());
+                    std::printf("%s: ok: sweep of %zu variant%s\n", file.c_str(), sw.variants().size(), sw.variants().size() == 1 ? "" : "s");
                     continue;
                 }
                 const Scenario s = load_scenario(file);

@@ -77,7 +77,8 @@ const std::vector<KeySpec>& scenario_keys()
         {"fills[].sizes[].radius_m", "number", "required", "sphere radius"},
         {"fills[].sizes[].mass_fraction", "number", "required", "fraction of the mass"},
         {"fills[].rocks", "list", "[]", "polyhedral rock classes of a mixed fill (Bullet bodies, thesis Paper A Table 1); "
-                                       "with rocks, sizes holds one sphere class and all fractions sum to 1"},
+                                       "with rocks, sizes holds one sphere class and all fractions sum to 1; a sphere fraction "
+                                       "of 0 places rocks alone (then set time.step_s)"},
         {"fills[].rocks[].size_m", "number", "required", "diameter of the sphere of equal volume"},
         {"fills[].rocks[].mass_fraction", "number", "required", "fraction of the fill's mass"},
         {"fills[].rock_elongation_max", "number", "2", "largest length-to-width ratio of the random rock shapes (1 to 4)"},
