@@ -53,8 +53,8 @@ ReposeFit fit_repose_angle(const ParticleStore& p, const ReposeWindow& w, const 
         throw InputError(concat(where, ": the surface in the window spans ", std::isfinite(zmax - zmin) ? zmax - zmin : 0.0,
                                 " m in height, less than one bin (", w.bin_m, " m): no bins lie on the slope of a pile"));
     // The slope: the longest run of neighbouring bins whose tops lie in the band between the flat top and
-    // the toe. A bin in the band but cut off from that run by one outside it is not on the slope: a rock
-    // rolled out past the toe, or a hump on the crest.
+    // the toe. A bin in the band but cut off from that run by one outside it is not on the slope, such as a
+    // rock rolled out past the toe.
     const double z_lo = zmin + w.low_fraction * (zmax - zmin), z_hi = zmin + w.high_fraction * (zmax - zmin);
     std::size_t best_first = 0, best_count = 0;
     for (std::size_t k = 0; k < fit.surface_m.size();) {
