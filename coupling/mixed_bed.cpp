@@ -144,7 +144,8 @@ private:
 }  // namespace
 
 MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, const MixedDistribution& distribution,
-                           const MixedMaterials& materials, double total_mass_kg, std::uint64_t seed, int attempts)
+                           const MixedMaterials& materials, double total_mass_kg, std::uint64_t seed, int attempts,
+                           const KeepFilter& keep)
 {
     const std::string where = "fill_mixed";
     distribution.validate(where);
@@ -205,6 +206,7 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
                 const Vec3 centre{c_min.x + u(rng) * (c_max.x - c_min.x), c_min.y + u(rng) * (c_max.y - c_min.y),
                                   c_min.z + u(rng) * (c_max.z - c_min.z)};
                 PlacedRock candidate = place(shape, r, centre);
+                if (keep && !keep(centre, candidate.radius)) continue;
                 bool clear = true;
                 for (const PlacedRock& o : placed) {
                     if (norm(o.centre - centre) > o.radius + candidate.radius) continue;
@@ -247,7 +249,7 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
         bool done = false;
         for (int attempt = 0; attempt < attempts && !done; ++attempt) {
             const Vec3 x{s_lo.x + u(rng) * (s_hi.x - s_lo.x), s_lo.y + u(rng) * (s_hi.y - s_lo.y), s_lo.z + u(rng) * (s_hi.z - s_lo.z)};
-            if (!grid.free(x, rs)) continue;
+            if (!grid.free(x, rs) || (keep && !keep(x, rs))) continue;
             bool clear = true;
             const int ci = cell_of(x.x, lo.x), cj = cell_of(x.y, lo.y), ck = cell_of(x.z, lo.z);
             for (int dk = -1; dk <= 1 && clear; ++dk)

@@ -46,23 +46,25 @@ struct MixedFillReport {
     double sphere_mass_kg = 0.0, rock_mass_kg = 0.0;
 };
 
+/// Which bodies fill_mixed and load_state place: keep(centre, radius) for a sphere (its centre and
+/// radius) and for a rock (its centroid and the radius of the sphere about it that holds its hull).
+using KeepFilter = std::function<bool(const Vec3& centre_m, double radius_m)>;
+
 /// Places `total_mass_kg` of mixed material at seeded random positions inside the box [lo, hi], none
 /// overlapping another or what the worlds already hold of it: rocks first, largest first, each turned at
 /// random; then spheres in the gaps. Class c gets round(f_c M / m_c) bodies, m_c the mass of one body of
 /// the class. The sphere material's density in the DEM table must equal materials.density_kg_per_m3.
+/// A place that `keep` refuses (a machine part's steel there) is tried again elsewhere.
 /// Throws InputError if a body finds no place in `attempts` tries (the box is too small for the mass).
 MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo_m, const Vec3& hi_m, const MixedDistribution& distribution,
-                           const MixedMaterials& materials, double total_mass_kg, std::uint64_t seed, int attempts = 20000);
+                           const MixedMaterials& materials, double total_mass_kg, std::uint64_t seed, int attempts = 20000,
+                           const KeepFilter& keep = {});
 
 /// Writes the spheres (position, velocity, spin, radius, material) and the rocks made with add_rock (shape,
 /// density, materials, pose, velocities) to a versioned text file, full precision. Only spheres whose
 /// centre and rocks whose centroid lie at or below `cut_above_m` are written (a pile cut at a height).
 void save_state(const CoupledWorld& world, const std::string& path,
                 double cut_above_m = std::numeric_limits<double>::infinity());
-
-/// Which bodies of a saved state load_state places: keep(centre, radius) for a sphere (its centre and
-/// radius) and for a rock (its centroid and the radius of the sphere about it that holds its hull).
-using KeepFilter = std::function<bool(const Vec3& centre_m, double radius_m)>;
 
 /// What load_state placed, and what the filter left out.
 struct LoadedState {

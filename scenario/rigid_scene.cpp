@@ -177,7 +177,9 @@ void RigidScene::fill_mixed(const Scenario& s)
             const dem::MaterialIndex sphere = table.index_of(f.material);
             const dem::MaterialIndex rock = table.index_of("rock");
             const coupling::MixedMaterials m{sphere, rock, rigid_->material_index("rock"), table.material(sphere).density_kg_per_m3};
-            coupling::fill_mixed(*coupled_, f.min_m, f.max_m, d, m, f.mass_kg, s.seed * 1000003ull + k);
+            // as a sphere fill does, the mixed fill keeps clear of the dipper and door where they stand at t = 0
+            coupling::fill_mixed(*coupled_, f.min_m, f.max_m, d, m, f.mass_kg, s.seed * 1000003ull + k, 20000,
+                                 [this](const Vec3& c, double r) { return clear_of_machine(c, r); });
         } catch (const InputError& e) {
             throw InputError(concat(f.where, ": ", e.what()));
         }

@@ -307,6 +307,69 @@ output: {vtk_interval_s: 0}
     fs::remove_all(dir);
 }
 
+TEST_CASE("a mixed fill where the shovel stands keeps its spheres and rocks clear of the dipper and door", "[scenario][shovel]")
+{
+    // the box holds the space the dipper takes at the start of the default cycle (x 13-17.5 m, |y| < 2.1 m,
+    // z 0.1-3.8 m), as a quick loading scenario's fill does
+    const Scenario s = parse_scenario(R"(dipper_scenario: 1
+threads: 1
+time: {duration_s: 0.002}
+planes:
+  - {name: ground, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+fills:
+  - mass_kg: 30000
+    box: {min_m: [12, -2.5, 0], max_m: [18.5, 2.5, 4.4]}
+    sizes: [{radius_m: 0.15, mass_fraction: 0.5}]
+    rocks: [{size_m: 0.6, mass_fraction: 0.5}]
+shovel: {element_size_m: 0.3}
+output: {vtk_interval_s: 0}
+)", "mixed_at_shovel.yaml", ".");
+    auto bound = [](const coupling::RockRecord& r) {
+        double radius = 0.0;
+        for (const Vec3& v : r.shape.vertices_m()) radius = std::max(radius, norm(v));
+        return radius;
+    };
+    // how many bodies of a fill the dipper's or door's surface passes within reach of
+    auto count_in_steel = [&](const RigidScene& scene, const dem::World& dem) {
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < dem.particles().size(); ++i)
+            n += !scene.clear_of_machine(dem.particles().position_m[i], dem.particles().radius_m[i]);
+        for (const coupling::RockRecord& r : scene.coupled().rocks())
+            n += !scene.clear_of_machine(scene.coupled().rigid().state(r.body).position_m, bound(r));
+        return n;
+    };
+    // the same fill placed without regard to the machine: bodies sit in the steel
+    {
+        auto dem = build_world(s);
+        RigidScene scene(s, *dem);
+        const FillSpec& f = s.fills[0];
+        coupling::MixedDistribution d;
+        d.sphere_radius_m = 0.15;
+        d.sphere_mass_fraction = 0.5;
+        d.rocks = {{0.6, 0.5}};
+        const dem::MaterialIndex ore = dem->materials().index_of("ore");
+        coupling::fill_mixed(scene.coupled(), f.min_m, f.max_m, d,
+                             {ore, dem->materials().index_of("rock"), scene.coupled().rigid().material_index("rock"),
+                              dem->materials().material(ore).density_kg_per_m3},
+                             f.mass_kg, 1);
+        CHECK(count_in_steel(scene, *dem) > 10);
+    }
+    // as a run fills it: none, the same mass, and the first step finds no body in the steel
+    auto dem = build_world(s);
+    RigidScene scene(s, *dem);
+    scene.fill_mixed(s);
+    CHECK(count_in_steel(scene, *dem) == 0);
+    REQUIRE(scene.coupled().rocks().size() > 20);
+    REQUIRE(dem->particles().size() > 200);
+    double rock_mass = 0.0;
+    for (const coupling::RockRecord& r : scene.coupled().rocks()) rock_mass += r.density_kg_per_m3 * r.shape.volume_m3();
+    // the class counts come from the mass alone (round(f M / m)): the rocks' true volume differs from the
+    // nominal sphere's by their shape, the spheres' total is exact to one sphere's mass
+    CHECK(std::abs(dem->total_mass_kg() - 15000.0) < dem->particles().mass_kg[0]);
+    CHECK(rock_mass > 0.5 * 15000.0);
+    CHECK_NOTHROW(scene.step());
+}
+
 TEST_CASE("material held in the dipper: its weight on dipper and door, the mass and fill factor it shows, "
           "and the pass recorded when the door opens", "[scenario][shovel]")
 {
