@@ -11,8 +11,10 @@ folder = sys.argv[1]
 
 
 def sweep_report(folder):
-    """A sweep folder: sweep.md with the table, and for one varied parameter sweep.png of the first pass's
-    mass and mean dig force (or the final mass) against it."""
+    """A sweep folder: sweep.md with the table, and when one parameter varies (besides `seed`) sweep.png of the
+    first pass's mass, dig and interface force and the dipper bottom's wear (or the repose angle, or the final
+    mass) against it. With several seeds per value, sweep.md also gets the seeds' means and ranges and the
+    figure shows each seed and the mean."""
     with open(os.path.join(folder, "sweep.csv")) as f:
         rows = list(csv.DictReader(f))
     columns = list(rows[0].keys()) if rows else []
@@ -25,16 +27,51 @@ def sweep_report(folder):
     for r in rows:
         lines.append("| " + " | ".join(r[c] for c in shown) + " |")
     lines.append("")
+
+    def number(text):
+        try:
+            return float(text)
+        except ValueError:
+            return float("nan")  # a variant that did not complete leaves its cells empty
+
+    quantities = [("pass1_mass_kg", "mass in the dipper, pass 1 [t]", 1e-3),
+                  ("pass1_mean_dig_force_N", "mean dig force, pass 1 [MN]", 1e-6),
+                  ("pass1_mean_interface_force_N", "mean interface force, pass 1 [MN]", 1e-6),
+                  ("wear_dipper_bottom_m3", "wear of the dipper's bottom [mm3]", 1e9)]
+    quantities = ([q for q in quantities if q[0] in columns] or
+                  ([("repose_angle_deg", "angle of repose [deg]", 1.0)] if "repose_angle_deg" in columns else []) or
+                  [("mass_kg", "mass [t]", 1e-3)])
+    # the parameter the figure is drawn against: the one that varies, seeds being repeats of each value
+    varied = [p for p in parameters if len({r[p] for r in rows}) > 1]
+    seeds = "seed" in varied and len(varied) > 1
+    axis = [p for p in varied if p != "seed"] if seeds else varied
+    groups = {}  # value of the axis parameter -> its rows, in the sweep's order
+    if len(axis) == 1:
+        for r in rows:
+            groups.setdefault(r[axis[0]], []).append(r)
+    if seeds and groups:
+        key = axis[0]
+        lines += [f"Over the seeds ({', '.join(sorted({r['seed'] for r in rows}, key=number))}): mean (lowest to highest)", "",
+                  "| " + " | ".join([key, "variants"] + [q[1] for q in quantities]) + " |",
+                  "|" + " --- |" * (2 + len(quantities))]
+        for value, members in groups.items():
+            cells = [value, str(len(members))]
+            for column, _, scale in quantities:
+                ys = [number(m[column]) * scale for m in members]
+                ys = [y for y in ys if y == y]
+                cells.append(f"{sum(ys) / len(ys):.4g} ({min(ys):.4g} to {max(ys):.4g})" if ys else "-")
+            lines.append("| " + " | ".join(cells) + " |")
+        lines.append("")
     figures = 0
-    if len(parameters) == 1 and rows:
+    if groups:
         try:
             import matplotlib
 
             matplotlib.use("Agg")
             import matplotlib.pyplot as plt
 
-            key = parameters[0]
-            labels = [r[key] for r in rows]
+            key = axis[0]
+            labels = list(groups.keys())
 
             def position(label):
                 text = label.strip("[] ")
@@ -47,23 +84,26 @@ def sweep_report(folder):
             categorical = any(x is None for x in xs)
             if categorical:
                 xs = list(range(len(labels)))
-            quantities = [("pass1_mass_kg", "mass in the dipper, pass 1 [t]", 1e-3),
-                          ("pass1_mean_dig_force_N", "mean dig force, pass 1 [MN]", 1e-6),
-                          ("pass1_mean_interface_force_N", "mean interface force, pass 1 [MN]", 1e-6)]
-            quantities = ([q for q in quantities if q[0] in columns] or
-                          ([("repose_angle_deg", "angle of repose [deg]", 1.0)] if "repose_angle_deg" in columns else []) or
-                          [("mass_kg", "mass [t]", 1e-3)])
             fig, axes = plt.subplots(1, len(quantities), figsize=(4.2 * len(quantities), 3.4), dpi=110)
             axes = axes if len(quantities) > 1 else [axes]
             for ax, (column, label, scale) in zip(axes, quantities):
-                ys = [float(r[column]) * scale if r[column] not in ("", "null") else float("nan") for r in rows]
-                ax.plot(xs, ys, "o-", color="tab:blue")
+                means = []
+                for x, value in zip(xs, labels):
+                    ys = [number(m[column]) * scale for m in groups[value]]
+                    done = [y for y in ys if y == y]
+                    means.append(sum(done) / len(done) if done else float("nan"))
+                    if seeds:
+                        ax.plot([x] * len(ys), ys, "o", color="0.6", markersize=4,
+                                label="one seed" if x == xs[0] else None)
+                ax.plot(xs, means, "o-", color="tab:blue", label="mean of the seeds" if seeds else None)
                 ax.set_xlabel(key)
                 ax.set_ylabel(label)
                 if categorical:
                     ax.set_xticks(xs)
                     ax.set_xticklabels(labels)
                 ax.grid(True, alpha=0.3)
+                if seeds and ax is axes[0]:
+                    ax.legend(fontsize=8)
             fig.tight_layout()
             fig.savefig(os.path.join(folder, "sweep.png"))
             plt.close(fig)

@@ -71,8 +71,8 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
         const int m = rigid_material_or_none(*rigid_, material);
         if (m < 0 && rocks)
             throw InputError(concat(s.source, ": rocks meet wall '", wall, "' of material '", material,
-                                    "', which has no rock coefficients in the rigid world; give it one of the rigid materials "
-                                    "rock, ground, bucket, truck, steel"));
+                                    "', which has no rock coefficients in the rigid world; give it one of the rigid materials ",
+                                    rigid_material_list()));
         return m;
     };
     for (const PlaneSpec& p : s.planes) {

@@ -334,11 +334,12 @@ void read_materials(const MapReader& top, Scenario& s)
     for (const MapReader& p : m.maps("rock_pairs")) {
         const std::vector<std::string> names = p.texts("materials");
         const auto rigid = [](const std::string& n) {
-            return n == "rock" || n == "ground" || n == "bucket" || n == "truck" || n == "steel";
+            const auto& known = rigid_material_names();
+            return std::find(known.begin(), known.end(), n) != known.end();
         };
         if (names.size() != 2 || !rigid(names[0]) || !rigid(names[1]) || (names[0] != "rock" && names[1] != "rock"))
             p.fail("materials", concat("[", joined(names), "]"),
-                   "[rock, X] with X one of the rigid materials rock, ground, bucket, truck, steel");
+                   concat("[rock, X] with X one of the rigid materials ", rigid_material_list()));
         RockPairSpec pair{names[0], names[1], p.number("friction"), p.number("restitution")};
         require_in_range(pair.friction, 0.0, 2.0, "friction", p.where("friction"));
         require_in_range(pair.restitution, 0.0, 1.0, "restitution", p.where("restitution"));

@@ -59,6 +59,21 @@ struct PourSpec : ParticleSource {
     double start_s = 0.0;  ///< nothing enters before this time
 };
 
+/// The materials of the rigid world (Bullet) a scenario can name: what rocks meet there. The DEM preset's
+/// surface materials that are not here (if any) touch spheres only.
+inline const std::vector<std::string>& rigid_material_names()
+{
+    static const std::vector<std::string> names{"rock", "ground", "bucket", "truck", "steel"};
+    return names;
+}
+/// The same, for messages: "rock, ground, ...".
+inline std::string rigid_material_list()
+{
+    std::string s;
+    for (const std::string& n : rigid_material_names()) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
 /// Friction and restitution of rocks against rocks or a rigid wall material (Bullet), over the preset's.
 struct RockPairSpec {
     std::string a, b;

@@ -220,9 +220,20 @@ TEST_CASE("materials.rock_pairs set the rocks' coefficients in Bullet over the p
     CHECK(w.pair_friction(rock, ground) == 0.3);
     CHECK(w.pair_restitution(ground, rock) == 0.2);
     CHECK(w.pair_friction(rock, bucket) == 0.53);  // not named: Table 2's value stays
+    // every rigid material a pair may name is one the scene's rigid world has, and a pair of rocks with it is taken
+    for (const std::string& name : rigid_material_names()) {
+        CHECK_NOTHROW(w.material_index(name));
+        const Scenario one = parse_scenario(base(mixed + "materials:\n  rock_pairs:\n    - {materials: [rock, " + name +
+                                                 "], friction: 0.7}\n"),
+                                            "case.yaml", ".");
+        auto one_dem = build_world(one);
+        RigidScene with(one, *one_dem);
+        CHECK(with.rigid().pair_friction(with.rigid().material_index("rock"), with.rigid().material_index(name)) == 0.7);
+    }
 
     std::string e = error_of(base(mixed + std::regex_replace(pairs, std::regex("\\[ground, rock\\]"), "[ground, bucket]")));
-    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[1].materials: got [ground, bucket]; expected [rock, X]"));
+    CHECK_THAT(e, Catch::Contains("materials.rock_pairs[1].materials: got [ground, bucket]; expected [rock, X]") &&
+                      Catch::Contains("one of the rigid materials rock, ground, bucket, truck, steel"));
     e = error_of(base(mixed + std::regex_replace(pairs, std::regex("\\[rock, rock\\]"), "[rock, ore]")));
     CHECK_THAT(e, Catch::Contains("materials.rock_pairs[0].materials: got [rock, ore]"));
     e = error_of(base(mixed + std::regex_replace(pairs, std::regex("friction: 1.1"), "friction: -0.1")));
