@@ -72,7 +72,7 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
         if (m < 0 && rocks)
             throw InputError(concat(s.source, ": rocks meet wall '", wall, "' of material '", material,
                                     "', which has no rock coefficients in the rigid world; give it one of the rigid materials ",
-                                    rigid_material_list()));
+                                    joined(rigid_material_names())));
         return m;
     };
     for (const PlaneSpec& p : s.planes) {

@@ -22,13 +22,6 @@ namespace dipper::scenario {
 
 namespace {
 
-std::string joined(const std::vector<std::string>& names)
-{
-    std::string s;
-    for (std::size_t k = 0; k < names.size(); ++k) s += (k ? ", " : "") + names[k];
-    return s;
-}
-
 /// A file named in the scenario: absolute, or relative to the scenario file's folder.
 std::string resolved(const std::string& base_dir, const std::string& file)
 {
@@ -339,7 +332,7 @@ void read_materials(const MapReader& top, Scenario& s)
         };
         if (names.size() != 2 || !rigid(names[0]) || !rigid(names[1]) || (names[0] != "rock" && names[1] != "rock"))
             p.fail("materials", concat("[", joined(names), "]"),
-                   concat("[rock, X] with X one of the rigid materials ", rigid_material_list()));
+                   concat("[rock, X] with X one of the rigid materials ", joined(rigid_material_names())));
         RockPairSpec pair{names[0], names[1], p.number("friction"), p.number("restitution")};
         require_in_range(pair.friction, 0.0, 2.0, "friction", p.where("friction"));
         require_in_range(pair.restitution, 0.0, 1.0, "restitution", p.where("restitution"));

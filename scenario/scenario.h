@@ -66,11 +66,11 @@ inline const std::vector<std::string>& rigid_material_names()
     static const std::vector<std::string> names{"rock", "ground", "bucket", "truck", "steel"};
     return names;
 }
-/// The same, for messages: "rock, ground, ...".
-inline std::string rigid_material_list()
+/// Names for messages: "a, b, c".
+inline std::string joined(const std::vector<std::string>& names)
 {
     std::string s;
-    for (const std::string& n : rigid_material_names()) s += (s.empty() ? "" : ", ") + n;
+    for (std::size_t k = 0; k < names.size(); ++k) s += (k ? ", " : "") + names[k];
     return s;
 }
 
