@@ -82,6 +82,8 @@ const std::vector<KeySpec>& scenario_keys()
         {"fills[].rocks[].size_m", "number", "required", "diameter of the sphere of equal volume"},
         {"fills[].rocks[].mass_fraction", "number", "required", "fraction of the fill's mass"},
         {"fills[].rock_elongation_max", "number", "2", "largest length-to-width ratio of the random rock shapes (1 to 4)"},
+        {"fills[].rock_points", "integer", "20", "points drawn per rock before its convex hull (8 to 100): fewer points give more "
+                                              "angular rocks with larger flat faces (docs/rigid.md)"},
 
         {"pours", "list", "[]", "particles entering from a box at a mass flow rate"},
         {"pours[].material", "string", "ore", "particle material"},

@@ -173,6 +173,7 @@ void RigidScene::fill_mixed(const Scenario& s)
         d.rocks.clear();
         for (const RockClassSpec& c : f.rocks) d.rocks.push_back({c.size_m, c.mass_fraction});
         d.elongation_max = f.rock_elongation_max;
+        d.rock_point_count = f.rock_points;
         try {
             const dem::MaterialIndex sphere = table.index_of(f.material);
             const dem::MaterialIndex rock = table.index_of("rock");

@@ -378,6 +378,9 @@ FillSpec read_fill(const Scenario& s, const MapReader& r)
     static_cast<ParticleSource&>(fill) = read_source(s, r, rocks.empty());
     fill.rock_elongation_max = r.number("rock_elongation_max");
     require_in_range(fill.rock_elongation_max, 1.0, 4.0, "rock_elongation_max", r.where("rock_elongation_max"));
+    const std::int64_t rock_points = r.integer("rock_points");
+    if (rock_points < 8 || rock_points > 100) r.fail("rock_points", concat(rock_points), "a number of points from 8 to 100");
+    fill.rock_points = static_cast<int>(rock_points);
     if (rocks.empty()) return fill;
     if (fill.sizes.classes.size() != 1)
         r.fail("sizes", concat(fill.sizes.classes.size(), " sphere classes"), "one sphere class in a fill with rocks");

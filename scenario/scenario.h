@@ -51,6 +51,7 @@ struct RockClassSpec {
 struct FillSpec : ParticleSource {
     std::vector<RockClassSpec> rocks;
     double rock_elongation_max = 2.0;
+    int rock_points = 20;  ///< points drawn per rock before its hull (rigid::RockShape::point_count)
 };
 
 struct PourSpec : ParticleSource {

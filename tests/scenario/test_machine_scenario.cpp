@@ -244,6 +244,29 @@ TEST_CASE("materials.rock_pairs set the rocks' coefficients in Bullet over the p
     CHECK_THAT(e, Catch::Contains("materials.rock_pairs[0].friction: got nothing"));
 }
 
+TEST_CASE("fills[].rock_points sets how many points each rock's hull is drawn from", "[scenario][shovel]")
+{
+    // A hull of n points has at most n vertices; at the default 20 points a rock keeps 18 on average
+    // (docs/rigid.md), so among the 28 rocks of 300 mm (1.5 t) some have more than 10.
+    const std::string mixed = "  - mass_kg: 3000\n    box: {min_m: [0, 0, 0], max_m: [3, 3, 3]}\n"
+                              "    sizes: [{radius_m: 0.1, mass_fraction: 0.5}]\n    rocks: [{size_m: 0.3, mass_fraction: 0.5}]\n";
+    const auto most_vertices = [&](const std::string& extra) {
+        const Scenario s = parse_scenario(base(mixed + extra), "case.yaml", ".");
+        auto dem = build_world(s);
+        RigidScene scene(s, *dem);
+        scene.fill_mixed(s);
+        REQUIRE(scene.coupled().rocks().size() > 10);
+        std::size_t most = 0;
+        for (const coupling::RockRecord& r : scene.coupled().rocks()) most = std::max(most, r.shape.vertices_m().size());
+        return most;
+    };
+    CHECK(most_vertices("") > 10);
+    CHECK(most_vertices("    rock_points: 8\n") <= 8);
+    CHECK_THAT(error_of(base(mixed + "    rock_points: 7\n")),
+               Catch::Contains("fills[1].rock_points: got 7; expected a number of points from 8 to 100"));
+    CHECK_THAT(error_of(base(mixed + "    rock_points: 12.5\n")), Catch::Contains("fills[1].rock_points") && Catch::Contains("an integer"));
+}
+
 TEST_CASE("rocks and walls the rigid world cannot hold are refused with the wall named", "[scenario][shovel]")
 {
     const std::string mixed = "  - mass_kg: 3000\n    box: {min_m: [0, 0, 0], max_m: [3, 3, 3]}\n"
