@@ -63,7 +63,9 @@ BulkDensityResult measure_bulk_density(const BulkDensityBox& box, double particl
     dem::WorldSettings ds;
     ds.threads = box.threads;
     dem::World dem(dem::MaterialTable::aitik_copper_ore(particle_density), ds);
-    rigid::RigidWorld rigid;
+    rigid::RigidSettings rs;
+    rs.threads = dem.threads();
+    rigid::RigidWorld rigid(rs);
     rigid::add_aitik_copper_ore_materials(rigid);
     CoupledWorld world(dem, rigid, CouplingSettings{box.substeps});
 

@@ -5,10 +5,37 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <set>
 #include <utility>
 
 namespace dipper::coupling {
+
+namespace {
+
+/// f(k) for k in [0, n) on `threads` threads. An exception stops nothing midway; the one of the lowest k is
+/// rethrown after the loop, so the error a user sees does not depend on the thread count.
+template <class F>
+void for_each_body(std::size_t n, int threads, F&& f)
+{
+    std::exception_ptr first;
+    std::size_t first_k = n;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t k = 0; k < n; ++k) {
+        try {
+            f(k);
+        } catch (...) {
+#pragma omp critical(dipper_coupling_error)
+            if (k < first_k) {
+                first_k = k;
+                first = std::current_exception();
+            }
+        }
+    }
+    if (first) std::rethrow_exception(first);
+}
+
+}  // namespace
 
 Vec3 rotation_vector(const Mat3& r)
 {
@@ -233,7 +260,7 @@ void CoupledWorld::start()
 void CoupledWorld::move_surfaces(double fraction)
 {
     const double interval = coupling_step_s();
-    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    for_each_body(bodies_.size(), dem_.threads(), [&](std::size_t k) {
         const Pose& a = before_[k];
         const Pose& b = after_[k];
         const Vec3 spin = spin_rad_[k];
@@ -242,7 +269,7 @@ void CoupledWorld::move_surfaces(double fraction)
             const dem::MeshWall& wall = dem_.mesh_wall(bodies_[k].wall);
             if (wall.velocity_at(wall.reference_point_m()) == Vec3{} && wall.angular_velocity_rad_per_s() == Vec3{} &&
                 wall.translation_m() == b.origin_m)
-                continue;
+                return;
         }
         const double angle = norm(spin);
         const Mat3 turn = angle > 0.0 ? rotation_about_axis(spin * (1.0 / angle), angle * fraction) : Mat3::identity();
@@ -251,7 +278,7 @@ void CoupledWorld::move_surfaces(double fraction)
         const Vec3 origin = centre + turn * (a.origin_m - a.centre_m);
         dem_.set_mesh_pose(bodies_[k].wall, rotation, origin, centre, (b.centre_m - a.centre_m) * (1.0 / interval),
                            spin * (1.0 / interval));
-    }
+    });
 }
 
 void CoupledWorld::step()
@@ -262,8 +289,10 @@ void CoupledWorld::step()
     }
     if (!started_) start();
 
-    // 1. Bullet steps with the spheres' mean reaction from the last sub-steps
-    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    // 1. Bullet steps with the spheres' mean reaction from the last sub-steps (each body's own data: the
+    // per-body loops run on the DEM's threads)
+    const int threads = dem_.threads();
+    for_each_body(bodies_.size(), threads, [&](std::size_t k) {
         CoupledBody& b = bodies_[k];
         b.applied_force_N = samples_ > 0 ? force_sum_[k] * (1.0 / samples_) : Vec3{};
         b.applied_torque_N_m = samples_ > 0 ? torque_sum_[k] * (1.0 / samples_) : Vec3{};
@@ -271,16 +300,16 @@ void CoupledWorld::step()
         before_[k] = pose_of(b);
         force_sum_[k] = Vec3{};
         torque_sum_[k] = Vec3{};
-    }
+    });
     samples_ = 0;
     auto mark = std::chrono::steady_clock::now();
     rigid_.step();
     auto now = std::chrono::steady_clock::now();
     rigid_seconds_ += std::chrono::duration<double>(now - mark).count();
-    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    for_each_body(bodies_.size(), threads, [&](std::size_t k) {
         after_[k] = pose_of(bodies_[k]);
         spin_rad_[k] = rotation_vector(after_[k].rotation * before_[k].rotation.transposed());
-    }
+    });
 
     // 2. and 3. the DEM sub-steps, the surfaces moving from the old poses to the new ones
     const int n = settings_.substeps;
@@ -291,10 +320,10 @@ void CoupledWorld::step()
         surface_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     hooks.after_forces = [&](std::uint64_t) {
-        for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        for_each_body(bodies_.size(), threads, [&](std::size_t k) {
             force_sum_[k] += dem_.wall_force_N(bodies_[k].wall);
             torque_sum_[k] += dem_.wall_torque_N_m(bodies_[k].wall);
-        }
+        });
         ++samples_;
     };
     dem_.run_steps(static_cast<std::uint64_t>(n), hooks);

@@ -42,6 +42,8 @@ RigidWorld::RigidWorld(RigidSettings settings)
     if (settings.contact_pool_size < 16 || settings.contact_pool_size > (1 << 22))
         throw InputError(concat("rigid settings: contact_pool_size is ", settings.contact_pool_size, "; expected 16..4194304"));
     if (!is_finite(settings.gravity_m_per_s2)) throw InputError("rigid settings: gravity is not finite");
+    if (settings.threads < 1 || settings.threads > 1024)
+        throw InputError(concat("rigid settings: threads is ", settings.threads, "; expected 1..1024"));
     impl_ = std::make_unique<Impl>(settings);
     gContactAddedCallback = pair_material_callback;
 }

@@ -40,6 +40,9 @@ struct RigidSettings {
     /// and a pair found apart is not searched again until the bodies' motion may have closed its gap
     /// (docs/rigid.md). true: Bullet's own algorithm, for comparison.
     bool bullet_convex_pairs = false;
+    /// Threads of the narrow phase (the contact search of each pair). The results do not depend on it: the
+    /// same bits on any number of threads.
+    int threads = 1;
 };
 
 /// Position, orientation and velocities of a body's centre of mass, world frame.

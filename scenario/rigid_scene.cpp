@@ -52,6 +52,7 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
     scenario_walls_ = dem.wall_count();
     rigid::RigidSettings settings;
     settings.gravity_m_per_s2 = s.gravity_m_per_s2;
+    settings.threads = dem.threads();  // the narrow phase on the DEM's threads (the same bits on any number)
     rigid_ = std::make_unique<rigid::RigidWorld>(settings);
     rigid::add_aitik_copper_ore_materials(*rigid_);
     // the DEM preset's other surfaces, with the same friction against rocks as against spheres (Table 2:

@@ -55,46 +55,100 @@ public:
         if (manifold_) m_dispatcher->releaseManifold(manifold_);
     }
 
-    void processCollision(const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
-                          btManifoldResult* result) override
+    /// The search of the next processCollision: the gap bound of a pair found apart, else GJK (and EPA). It reads
+    /// only this pair and the two hulls, so that the pairs of one step can be searched at the same time.
+    /// `object0` and `object1` are the collision objects that hold the hulls (for the breaking distance).
+    void search(const btConvexShape& a, const btTransform& ta, const btConvexShape& b, const btTransform& tb, const btCollisionObject& object0,
+                const btCollisionObject& object1, btScalar distance_threshold, btIDebugDraw* draw, ConvexPairSearch& out) const
     {
-        const btTransform& ta = body0->getWorldTransform();
-        const btTransform& tb = body1->getWorldTransform();
-        if (apart_) {
-            if (still_apart(ta, tb)) return;
-            apart_ = false;
-        }
-        const auto* a = static_cast<const btConvexShape*>(body0->getCollisionShape());
-        const auto* b = static_cast<const btConvexShape*>(body1->getCollisionShape());
-        const btScalar breaking = manifold_ ? manifold_->getContactBreakingThreshold() : breaking_distance(body0, body1);
+        out = ConvexPairSearch{};
+        out.still_apart = apart_ && still_apart(ta, tb);
+        if (out.still_apart) return;
+        out.breaking = breaking_distance(&object0, &object1);
         btGjkPairDetector::ClosestPointInput input;
-        const btScalar reach = a->getMargin() + b->getMargin() + breaking + result->m_closestPointDistanceThreshold;
+        const btScalar reach = a.getMargin() + b.getMargin() + out.breaking + distance_threshold;
         input.m_maximumDistanceSquared = reach * reach;
         input.m_transformA = ta;
         input.m_transformB = tb;
         btVoronoiSimplexSolver simplex;
-        btGjkPairDetector gjk(a, b, &simplex, penetration_);
+        btGjkPairDetector gjk(&a, &b, &simplex, penetration_);
         ClosestPoints closest;
-        gjk.getClosestPoints(input, closest, info.m_debugDraw);
+        gjk.getClosestPoints(input, closest, draw);
+        out.found = closest.found;
+        out.axis = closest.found ? closest.normal : gjk.getCachedSeparatingAxis();
+        out.point = closest.point;
+        out.distance = closest.distance;
+    }
 
-        const bool near = closest.found && closest.distance <= breaking;
-        if (near) {
-            if (!manifold_) manifold_ = m_dispatcher->getNewManifold(body0->getCollisionObject(), body1->getCollisionObject());
+    void clear_apart() { apart_ = false; }
+
+    /// Whether a pair found apart is still apart by its gap bound: its next processCollision would do nothing.
+    bool still_apart(const btCollisionObject& body0, const btCollisionObject& body1) const
+    {
+        return apart_ && still_apart(body0.getWorldTransform(), body1.getWorldTransform());
+    }
+
+    /// The same for a pair of two whole bodies (the top-level pairs of a dispatch).
+    void search(const btCollisionObject& body0, const btCollisionObject& body1, btIDebugDraw* draw, ConvexPairSearch& out) const
+    {
+        search(*static_cast<const btConvexShape*>(body0.getCollisionShape()), body0.getWorldTransform(),
+               *static_cast<const btConvexShape*>(body1.getCollisionShape()), body1.getWorldTransform(), body0, body1, 0, draw, out);
+    }
+
+    void processCollision(const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
+                          btManifoldResult* result) override
+    {
+        ConvexPairSearch s;
+        search(*static_cast<const btConvexShape*>(body0->getCollisionShape()), body0->getWorldTransform(),
+               *static_cast<const btConvexShape*>(body1->getCollisionShape()), body1->getWorldTransform(), *body0->getCollisionObject(),
+               *body1->getCollisionObject(), result->m_closestPointDistanceThreshold, info.m_debugDraw, s);
+        if (s.still_apart) return;
+        apart_ = false;
+        finish(take(body0, body1, s, result), body0, body1, s, result);
+    }
+
+    /// What processCollision does after its search, in two parts: first whatever touches only this pair's own
+    /// manifold (its new point, the refresh of its points, the gap bound of a pair found apart); then, if
+    /// that part returns a ManifoldChange, the making or releasing of the manifold (the dispatcher's shared
+    /// list). In one call they are the steps of Bullet's convex-convex algorithm, in its order:
+    ///  - near (within the breaking distance): a manifold (made if there is none), the point added, the points
+    ///    refreshed, and the manifold released if none is left;
+    ///  - not near: the points of a manifold refreshed, the manifold released if none is left, then the gap bound
+    ///    started.
+    ManifoldChange take(const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1, const ConvexPairSearch& s,
+                        btManifoldResult* result)
+    {
+        if (near(s)) {
+            if (!manifold_) return ManifoldChange::make;
             result->setPersistentManifold(manifold_);
-            result->addContactPoint(closest.normal, closest.point, closest.distance);
+            result->addContactPoint(s.axis, s.point, s.distance);
         }
         if (manifold_) {
             result->setPersistentManifold(manifold_);
             result->refreshContactPoints();
+            return manifold_->getNumContacts() > 0 ? ManifoldChange::none : ManifoldChange::release;
+        }
+        if (result->m_closestPointDistanceThreshold == 0) start_apart(body0, body1, s);
+        return ManifoldChange::none;
+    }
+
+    void finish(ManifoldChange change, const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1, const ConvexPairSearch& s,
+                btManifoldResult* result)
+    {
+        if (change == ManifoldChange::make) {
+            manifold_ = m_dispatcher->getNewManifold(body0->getCollisionObject(), body1->getCollisionObject());
+            result->setPersistentManifold(manifold_);
+            result->addContactPoint(s.axis, s.point, s.distance);
+            result->setPersistentManifold(manifold_);
+            result->refreshContactPoints();
             if (manifold_->getNumContacts() > 0) return;
-            result->setPersistentManifold(nullptr);
-            m_dispatcher->releaseManifold(manifold_);
-            manifold_ = nullptr;
+            change = ManifoldChange::release;
         }
-        if (!near && result->m_closestPointDistanceThreshold == 0) {
-            const btVector3 axis = closest.found ? closest.normal : gjk.getCachedSeparatingAxis();
-            start_apart(*a, *b, ta, tb, axis, breaking);
-        }
+        if (change != ManifoldChange::release) return;
+        result->setPersistentManifold(nullptr);
+        m_dispatcher->releaseManifold(manifold_);
+        manifold_ = nullptr;
+        if (!near(s) && result->m_closestPointDistanceThreshold == 0) start_apart(body0, body1, s);
     }
 
     btScalar calculateTimeOfImpact(btCollisionObject*, btCollisionObject*, const btDispatcherInfo&, btManifoldResult*) override
@@ -108,14 +162,24 @@ public:
     }
 
 private:
-    /// The breaking distance Bullet's dispatcher gives a new manifold of these two objects.
-    btScalar breaking_distance(const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1) const
+    /// The contact breaking distance of this pair: its manifold's, or the one Bullet's dispatcher gives a new
+    /// manifold of these two objects.
+    btScalar breaking_distance(const btCollisionObject* body0, const btCollisionObject* body1) const
     {
+        if (manifold_) return manifold_->getContactBreakingThreshold();
         const auto* dispatcher = static_cast<const btCollisionDispatcher*>(m_dispatcher);
         if (!(dispatcher->getDispatcherFlags() & btCollisionDispatcher::CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD))
             return gContactBreakingThreshold;
-        return btMin(body0->getCollisionObject()->getCollisionShape()->getContactBreakingThreshold(gContactBreakingThreshold),
-                     body1->getCollisionObject()->getCollisionShape()->getContactBreakingThreshold(gContactBreakingThreshold));
+        return btMin(body0->getCollisionShape()->getContactBreakingThreshold(gContactBreakingThreshold),
+                     body1->getCollisionShape()->getContactBreakingThreshold(gContactBreakingThreshold));
+    }
+
+    static bool near(const ConvexPairSearch& s) { return s.found && s.distance <= s.breaking; }
+
+    void start_apart(const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1, const ConvexPairSearch& s)
+    {
+        start_apart(*static_cast<const btConvexShape*>(body0->getCollisionShape()), *static_cast<const btConvexShape*>(body1->getCollisionShape()),
+                    body0->getWorldTransform(), body1->getWorldTransform(), s.axis, s.breaking);
     }
 
     void start_apart(const btConvexShape& a, const btConvexShape& b, const btTransform& ta, const btTransform& tb, const btVector3& axis,
@@ -185,6 +249,27 @@ btCollisionAlgorithm* ConvexPairCreateFunc::CreateCollisionAlgorithm(btCollision
                        ? info.m_dispatcher1->allocateCollisionAlgorithm(static_cast<int>(sizeof(ConvexPair)))
                        : btAlignedAlloc(sizeof(ConvexPair), 16);
     return new (memory) ConvexPair(info, body0, body1, &penetration_solver);
+}
+
+bool convex_pair_still_apart(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1)
+{
+    return static_cast<const ConvexPair&>(pair).still_apart(body0, body1);
+}
+
+ManifoldChange take_convex_pair(btCollisionAlgorithm& pair, const btCollisionObjectWrapper& body0, const btCollisionObjectWrapper& body1,
+                                const btDispatcherInfo& info, btManifoldResult& result, ConvexPairSearch& search)
+{
+    auto& p = static_cast<ConvexPair&>(pair);
+    p.search(*body0.getCollisionObject(), *body1.getCollisionObject(), info.m_debugDraw, search);
+    if (search.still_apart) return ManifoldChange::none;
+    p.clear_apart();
+    return p.take(&body0, &body1, search, &result);
+}
+
+void finish_convex_pair(btCollisionAlgorithm& pair, ManifoldChange change, const btCollisionObjectWrapper& body0,
+                        const btCollisionObjectWrapper& body1, const ConvexPairSearch& search, btManifoldResult& result)
+{
+    static_cast<ConvexPair&>(pair).finish(change, &body0, &body1, search, &result);
 }
 
 }  // namespace dipper::rigid

@@ -19,4 +19,31 @@ struct ConvexPairCreateFunc : public btCollisionAlgorithmCreateFunc {
     btGjkEpaPenetrationDepthSolver penetration_solver;  ///< stateless: shared by the pairs
 };
 
+/// What the search of a hull pair found: the part of its processCollision that touches no manifold.
+struct ConvexPairSearch {
+    bool still_apart = false;  ///< the pair's gap bound still clears it: nothing to do this step
+    bool found = false;        ///< GJK found closest points within reach
+    btVector3 axis{0, 0, 0};   ///< the normal on b when found, else GJK's separating axis
+    btVector3 point{0, 0, 0};  ///< closest point on b
+    btScalar distance = 0;
+    btScalar breaking = 0;     ///< the pair's contact breaking distance (not set when still apart)
+};
+
+/// Whether the pair of two whole bodies (a top-level pair whose algorithm a ConvexPairCreateFunc made) is
+/// still apart by its gap bound, so that its next processCollision would return at once. It reads only the
+/// pair and the bodies' poses.
+bool convex_pair_still_apart(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1);
+
+/// What is left of a pair's processCollision after the part that touches only its own manifold.
+enum class ManifoldChange { none, make, release };
+
+/// A top-level pair's processCollision in two parts. take_convex_pair does the search and whatever touches only
+/// the pair's own manifold; it may run for many pairs at once. finish_convex_pair then makes or releases the
+/// manifold where take_convex_pair returned that (the dispatcher's manifold list: one thread, in the pairs'
+/// order). The two in a row are processCollision; `search` carries what the first found to the second.
+ManifoldChange take_convex_pair(btCollisionAlgorithm& pair, const btCollisionObjectWrapper& body0, const btCollisionObjectWrapper& body1,
+                                const btDispatcherInfo& info, btManifoldResult& result, ConvexPairSearch& search);
+void finish_convex_pair(btCollisionAlgorithm& pair, ManifoldChange change, const btCollisionObjectWrapper& body0,
+                        const btCollisionObjectWrapper& body1, const ConvexPairSearch& search, btManifoldResult& result);
+
 }  // namespace dipper::rigid

@@ -6,6 +6,7 @@
 #include "meshes/triangle_locator.h"
 #include "rigid/rigid_world.h"
 #include "rigid/detail/convex_pair.h"
+#include "rigid/detail/dispatcher.h"
 
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionDispatch/btInternalEdgeUtility.h>
@@ -114,7 +115,7 @@ struct RigidWorld::Impl {
     RigidSettings settings;
     btDefaultCollisionConfiguration config;
     ConvexPairCreateFunc convex_pairs{config.getCollisionAlgorithmPool()->getElementSize()};  // outlives the world's pairs
-    btCollisionDispatcher dispatcher{&config};
+    Dispatcher dispatcher{&config, settings.threads, !settings.bullet_convex_pairs};
     btDbvtBroadphase broadphase;
     btMultiBodyConstraintSolver solver;
     btMultiBodyDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};

@@ -42,6 +42,7 @@ struct Bed {
               rigid::RigidSettings s;
               s.contact_pool_size = 8192;
               s.bullet_convex_pairs = bullet_pairs;
+              s.threads = threads;
               return s;
           }()),
           world(dem, rigid, coupling::CouplingSettings{substeps})

@@ -2,11 +2,12 @@
 // the pile's weight. Rocks of the thesis' size classes (Table 1 mass fractions 300/400/600/850 mm =
 // 10/9/19/25) are dropped from a loose lattice onto the ground and settled; then steps are timed.
 // Usage: dipper_bench_rock_pile [--rocks N] [--dt S] [--settle-s S] [--settle-dt S] [--steps N] [--point-count N]
-//                               [--iterations N] [--margin-fraction F] [--pool N] [--pairs dipper|bullet]
+//                               [--iterations N] [--margin-fraction F] [--pool N] [--pairs dipper|bullet] [--threads N]
 // The pile settles at --settle-dt (default 1e-3 s), then takes 100 steps at --dt before the timed ones.
 // --dt may list several steps (--dt 1e-3,1e-4): the settled pile is timed at each in turn, so a large
 // pile settles once. --pairs bullet steps hull pairs with Bullet's own convex-convex algorithm instead of
-// dipper's (RigidSettings::bullet_convex_pairs), for comparison.
+// dipper's (RigidSettings::bullet_convex_pairs), for comparison. --threads: the narrow phase's threads
+// (RigidSettings::threads; the same pile to the bit on any number).
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"
 #include "tests/bench/options.h"
@@ -28,13 +29,13 @@ using namespace dipper::rigid;
 
 int main(int argc, char** argv)
 {
-    int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 4096;
+    int rocks = 1000, steps = 200, point_count = 20, iterations = 10, pool = 4096, threads = 1;
     double settle_s = 2.0, settle_dt = 1e-3, margin_fraction = 0.05;
     std::string pairs = "dipper";
     std::vector<double> dts{1e-3};
     const char* help = "usage: dipper_bench_rock_pile [--rocks N] [--dt S[,S...]] [--settle-s S] [--settle-dt S] [--steps N]\n"
                         "                              [--point-count N] [--iterations N] [--pool N] [--margin-fraction F]\n"
-                       "                              [--pairs dipper|bullet]\n";
+                       "                              [--pairs dipper|bullet] [--threads N]\n";
     const int status = bench::read_options(argc, argv, help, [&](const std::string& key, const char* value) {
         if (key == "--rocks") rocks = std::atoi(value);
         else if (key == "--dt") {
@@ -51,6 +52,7 @@ int main(int argc, char** argv)
         else if (key == "--pool") pool = std::atoi(value);
         else if (key == "--margin-fraction") margin_fraction = std::atof(value);
         else if (key == "--pairs") pairs = value;
+        else if (key == "--threads") threads = std::atoi(value);
         else return false;
         return true;
     });
@@ -66,6 +68,7 @@ int main(int argc, char** argv)
     settings.contact_pool_size = pool;
     settings.rock_margin_fraction = margin_fraction;
     settings.bullet_convex_pairs = bullet_pairs;
+    settings.threads = threads;
     RigidWorld w(settings);
     w.add_material("rock");
     w.add_material("ground");
@@ -94,7 +97,7 @@ int main(int argc, char** argv)
     const int settle_steps = static_cast<int>(std::lround(settle_s / settle_dt));
     for (int k = 0; k < settle_steps; ++k) w.step();
     const double settle_wall = std::chrono::duration<double>(clock::now() - t0).count();
-    std::printf("rocks %d  settled %.1f s at %g s (%.1f s wall)\n", rocks, settle_s, settle_dt, settle_wall);
+    std::printf("rocks %d  settled %.1f s at %g s (%.1f s wall), %d thread(s)\n", rocks, settle_s, settle_dt, settle_wall, threads);
 
     for (const double dt : dts) {
         if (!(dt > 0.0)) {

@@ -1,0 +1,55 @@
+// Bullet's collision dispatcher with the narrow phase of one step spread over threads. Not installed; nothing
+// outside rigid/ includes it.
+#pragma once
+
+#include "rigid/detail/convex_pair.h"
+
+#include <btBulletCollisionCommon.h>
+
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+namespace dipper::rigid {
+
+/// Runs the narrow phase of a step in two passes over the overlapping pairs, so that most of it runs on
+/// several threads and the step still gives the same bits as Bullet's own one-pass dispatch:
+///  1. on `threads` threads, each pair on its own: the needsCollision check; whole pairs whose work touches
+///     only their own persistent manifold (a hull against a triangle mesh or a plane: Bullet's convex-concave
+///     and convex-plane algorithms, whose manifold exists from the pair's start); for hull-hull pairs of
+///     dipper's ConvexPair, the gap bound, the search and the pair's own manifold's points;
+///  2. on one thread, in the pair array's order, as Bullet's dispatch does: whatever makes or releases a
+///     manifold (a hull pair coming into or out of contact, a new pair, compound shapes, every other kind).
+/// Each manifold receives the same points as in Bullet's dispatch, and the dispatcher's manifold list changes
+/// in the same order, so the solver sees the same rows in the same order: the same bits on any number of
+/// threads. One thread: Bullet's own dispatch.
+class Dispatcher final : public btCollisionDispatcher {
+public:
+    /// `dipper_pairs`: hull-hull pairs are dipper's ConvexPair (RigidSettings::bullet_convex_pairs false).
+    Dispatcher(btCollisionConfiguration* config, int threads, bool dipper_pairs)
+        : btCollisionDispatcher(config), threads_(threads), dipper_pairs_(dipper_pairs)
+    {
+    }
+
+    void dispatchAllCollisionPairs(btOverlappingPairCache* pairs, const btDispatcherInfo& info, btDispatcher* dispatcher) override;
+
+    // the algorithm pool is shared: locked while pass 1 runs (a hull against a mesh makes one per triangle)
+    void* allocateCollisionAlgorithm(int size) override;
+    void freeCollisionAlgorithm(void* ptr) override;
+
+private:
+    /// What a pair needs this step: nothing; nothing more (done in pass 1); hull-hull (dipper's ConvexPair);
+    /// a manifold made or released in pass 2; all of it in pass 2.
+    enum class Work : std::uint8_t { none, done, hulls, make_manifold, release_manifold, serial };
+    void process(btBroadphasePair& pair, const btDispatcherInfo& info);
+    Work kind(const btBroadphasePair& pair) const;
+
+    int threads_;
+    bool dipper_pairs_;
+    bool parallel_ = false;  ///< pass 1 is running
+    std::mutex pool_;
+    std::vector<Work> work_;                   ///< of each pair, this step
+    std::vector<ConvexPairSearch> searches_;  ///< of each hull pair searched in pass 1, for pass 2
+};
+
+}  // namespace dipper::rigid
