@@ -8,7 +8,7 @@ const std::vector<KeySpec>& scenario_keys()
         {"dipper_scenario", "integer", "required", "format version of the file; 1"},
         {"name", "string", "none", "name of the run in reports; the file name without extension if absent"},
         {"seed", "integer", "1", "seed of every random choice (fills, pours); same seed, same run"},
-        {"threads", "integer", "0", "OpenMP threads; 0 takes OMP_NUM_THREADS or all cores"},
+        {"threads", "integer", "0", "OpenMP threads of the spheres, the coupling and Bullet's narrow phase; 0 takes OMP_NUM_THREADS or all cores"},
         {"gravity_m_per_s2", "vector3", "[0, 0, -9.81]", "gravitational acceleration"},
 
         {"time", "map", "required", "time stepping"},
