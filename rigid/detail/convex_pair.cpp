@@ -203,8 +203,8 @@ private:
                 rotation_b_[3 * i + j] = static_cast<float>(tb.getBasis()[i][j]);
             }
         // rounded up: the bound must not shrink
-        radius_a_ = std::nextafter(static_cast<float>(a.getAngularMotionDisc()), std::numeric_limits<float>::infinity());
-        radius_b_ = std::nextafter(static_cast<float>(b.getAngularMotionDisc()), std::numeric_limits<float>::infinity());
+        radius_a_ = hull_motion_radius(a);
+        radius_b_ = hull_motion_radius(b);
         apart_ = true;
     }
 
@@ -220,14 +220,22 @@ private:
         return std::sqrt(sum) + 1e-6;
     }
 
-    bool still_apart(const btTransform& ta, const btTransform& tb) const
+    bool still_apart(const btTransform& ta, const btTransform& tb) const { return apart_margin(ta, tb) > 0; }
+
+public:
+    /// What is left of the gap of a pair found apart after the bound of the bodies' motion since then; the pair
+    /// is still apart while it is positive. -inf for a pair not found apart.
+    double apart_margin(const btTransform& ta, const btTransform& tb) const
     {
+        if (!apart_) return -std::numeric_limits<double>::infinity();
         const btVector3 n(normal_[0], normal_[1], normal_[2]);
         const double approach = (n.dot(tb.getOrigin()) - along_b_) - (n.dot(ta.getOrigin()) - along_a_);
         const double turn = (radius_a_ * rotation_change(ta.getBasis(), rotation_a_) + radius_b_ * rotation_change(tb.getBasis(), rotation_b_)) *
                             0.70710678118654752;
-        return gap_ - approach - turn > 0;
+        return gap_ - approach - turn;
     }
+
+private:
 
     btConvexPenetrationDepthSolver* penetration_;
     btPersistentManifold* manifold_ = nullptr;
@@ -254,6 +262,16 @@ btCollisionAlgorithm* ConvexPairCreateFunc::CreateCollisionAlgorithm(btCollision
 bool convex_pair_still_apart(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1)
 {
     return static_cast<const ConvexPair&>(pair).still_apart(body0, body1);
+}
+
+double convex_pair_apart_margin(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1)
+{
+    return static_cast<const ConvexPair&>(pair).apart_margin(body0.getWorldTransform(), body1.getWorldTransform());
+}
+
+float hull_motion_radius(const btCollisionShape& shape)
+{
+    return std::nextafter(static_cast<float>(shape.getAngularMotionDisc()), std::numeric_limits<float>::infinity());
 }
 
 ManifoldChange take_convex_pair(btCollisionAlgorithm& pair, const btCollisionObjectWrapper& body0, const btCollisionObjectWrapper& body1,

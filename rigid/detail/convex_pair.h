@@ -34,6 +34,12 @@ struct ConvexPairSearch {
 /// pair and the bodies' poses.
 bool convex_pair_still_apart(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1);
 
+/// What is left of the gap of a pair found apart (as above) once the bound of the bodies' motion since then is
+/// taken off: the pair is still apart while it is positive; -inf when the pair is not in that state.
+double convex_pair_apart_margin(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1);
+/// The radius a ConvexPair's gap bound turns a hull by: its angular motion disc, rounded up to a float.
+float hull_motion_radius(const btCollisionShape& shape);
+
 /// What is left of a pair's processCollision after the part that touches only its own manifold.
 enum class ManifoldChange { none, make, release };
 

@@ -20,6 +20,8 @@ namespace dipper::rigid {
 ///     dipper's ConvexPair, the gap bound, the search and the pair's own manifold's points;
 ///  2. on one thread, in the pair array's order, as Bullet's dispatch does: whatever makes or releases a
 ///     manifold (a hull pair coming into or out of contact, a new pair, compound shapes, every other kind).
+/// Before both, a hull pair found apart is passed over unread while its bodies' odometers show too little motion
+/// to have closed its gap (dispatcher.cpp).
 /// Each manifold receives the same points as in Bullet's dispatch, and the dispatcher's manifold list changes
 /// in the same order, so the solver sees the same rows in the same order: the same bits on any number of
 /// threads. One thread: Bullet's own dispatch.
@@ -30,6 +32,9 @@ public:
         : btCollisionDispatcher(config), threads_(threads), dipper_pairs_(dipper_pairs)
     {
     }
+
+    /// The collision objects whose motion the odometers follow (the world's; set once the world exists).
+    void watch(const btCollisionObjectArray* objects) { objects_ = objects; }
 
     void dispatchAllCollisionPairs(btOverlappingPairCache* pairs, const btDispatcherInfo& info, btDispatcher* dispatcher) override;
 
@@ -43,6 +48,11 @@ private:
     enum class Work : std::uint8_t { none, done, hulls, make_manifold, release_manifold, serial };
     void process(btBroadphasePair& pair, const btDispatcherInfo& info);
     Work kind(const btBroadphasePair& pair) const;
+    void update_odometers();
+    double moved(const btBroadphasePair& pair) const;
+    bool clear_by_odometers(const btBroadphasePair& pair) const;
+    void note_gap(btBroadphasePair& pair) const;
+    void clear_thresholds(btOverlappingPairCache* pairs);
 
     int threads_;
     bool dipper_pairs_;
@@ -50,6 +60,17 @@ private:
     std::mutex pool_;
     std::vector<Work> work_;                   ///< of each pair, this step
     std::vector<ConvexPairSearch> searches_;  ///< of each hull pair searched in pass 1, for pass 2
+
+    // Odometers: for each broad-phase proxy (by its unique id), the distance its origin has travelled plus its
+    // hull's radius times the Frobenius norm of each step's change of rotation, summed over the steps. The
+    // motion of two bodies between two steps is bounded by the growth of their odometers, so a hull pair found
+    // apart can be passed over while that growth stays below what is left of its gap, without reading the pair
+    // (rigid/detail/dispatcher.cpp).
+    const btCollisionObjectArray* objects_ = nullptr;
+    std::vector<double> odometer_, radius_;
+    std::vector<btTransform> previous_;
+    std::vector<const btCollisionShape*> shape_;
+    bool thresholds_set_ = false;  ///< some pair holds a threshold (the two-pass dispatch ran)
 };
 
 }  // namespace dipper::rigid

@@ -109,6 +109,7 @@ struct RigidWorld::Impl {
         info.m_splitImpulsePenetrationThreshold = -s.split_impulse_threshold_m;
         if (!s.bullet_convex_pairs)
             dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, CONVEX_HULL_SHAPE_PROXYTYPE, &convex_pairs);
+        dispatcher.watch(&world.getCollisionObjectArray());
     }
     ~Impl();  // rope_shovel.cpp: the shovel's multibody goes first
 
