@@ -82,10 +82,16 @@ public:
 
     void clear_apart() { apart_ = false; }
 
-    /// Whether a pair found apart is still apart by its gap bound: its next processCollision would do nothing.
-    bool still_apart(const btCollisionObject& body0, const btCollisionObject& body1) const
+    /// What is left of the gap of a pair found apart after the bound of the bodies' motion since then; the pair
+    /// is still apart while it is positive. -inf for a pair not found apart.
+    double apart_margin(const btTransform& ta, const btTransform& tb) const
     {
-        return apart_ && still_apart(body0.getWorldTransform(), body1.getWorldTransform());
+        if (!apart_) return -std::numeric_limits<double>::infinity();
+        const btVector3 n(normal_[0], normal_[1], normal_[2]);
+        const double approach = (n.dot(tb.getOrigin()) - along_b_) - (n.dot(ta.getOrigin()) - along_a_);
+        const double turn = (radius_a_ * rotation_change(ta.getBasis(), rotation_a_) + radius_b_ * rotation_change(tb.getBasis(), rotation_b_)) *
+                            0.70710678118654752;
+        return gap_ - approach - turn;
     }
 
     /// The same for a pair of two whole bodies (the top-level pairs of a dispatch).
@@ -222,21 +228,6 @@ private:
 
     bool still_apart(const btTransform& ta, const btTransform& tb) const { return apart_margin(ta, tb) > 0; }
 
-public:
-    /// What is left of the gap of a pair found apart after the bound of the bodies' motion since then; the pair
-    /// is still apart while it is positive. -inf for a pair not found apart.
-    double apart_margin(const btTransform& ta, const btTransform& tb) const
-    {
-        if (!apart_) return -std::numeric_limits<double>::infinity();
-        const btVector3 n(normal_[0], normal_[1], normal_[2]);
-        const double approach = (n.dot(tb.getOrigin()) - along_b_) - (n.dot(ta.getOrigin()) - along_a_);
-        const double turn = (radius_a_ * rotation_change(ta.getBasis(), rotation_a_) + radius_b_ * rotation_change(tb.getBasis(), rotation_b_)) *
-                            0.70710678118654752;
-        return gap_ - approach - turn;
-    }
-
-private:
-
     btConvexPenetrationDepthSolver* penetration_;
     btPersistentManifold* manifold_ = nullptr;
     bool apart_ = false;
@@ -257,11 +248,6 @@ btCollisionAlgorithm* ConvexPairCreateFunc::CreateCollisionAlgorithm(btCollision
                        ? info.m_dispatcher1->allocateCollisionAlgorithm(static_cast<int>(sizeof(ConvexPair)))
                        : btAlignedAlloc(sizeof(ConvexPair), 16);
     return new (memory) ConvexPair(info, body0, body1, &penetration_solver);
-}
-
-bool convex_pair_still_apart(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1)
-{
-    return static_cast<const ConvexPair&>(pair).still_apart(body0, body1);
 }
 
 double convex_pair_apart_margin(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1)

@@ -29,13 +29,10 @@ struct ConvexPairSearch {
     btScalar breaking = 0;     ///< the pair's contact breaking distance (not set when still apart)
 };
 
-/// Whether the pair of two whole bodies (a top-level pair whose algorithm a ConvexPairCreateFunc made) is
-/// still apart by its gap bound, so that its next processCollision would return at once. It reads only the
-/// pair and the bodies' poses.
-bool convex_pair_still_apart(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1);
-
-/// What is left of the gap of a pair found apart (as above) once the bound of the bodies' motion since then is
-/// taken off: the pair is still apart while it is positive; -inf when the pair is not in that state.
+/// For the pair of two whole bodies (a top-level pair whose algorithm a ConvexPairCreateFunc made): what is left
+/// of the gap of a pair found apart once the bound of the bodies' motion since then is taken off. The pair is
+/// still apart, and its next processCollision would return at once, while it is positive; -inf when the pair
+/// is not in that state. It reads only the pair and the bodies' poses.
 double convex_pair_apart_margin(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1);
 /// The radius a ConvexPair's gap bound turns a hull by: its angular motion disc, rounded up to a float.
 float hull_motion_radius(const btCollisionShape& shape);

@@ -61,6 +61,10 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "--pairs is '%s'; expected dipper or bullet\n", pairs.c_str());
         return 2;
     }
+    if (threads < 1) {
+        std::fprintf(stderr, "--threads is %d; expected a whole number >= 1\n", threads);
+        return 2;
+    }
     const bool bullet_pairs = pairs == "bullet";
     RigidSettings settings;
     settings.step_s = settle_dt;
