@@ -6,6 +6,7 @@
 // The bed is filled loosely in a box, settled for --settle-s at n = 10 and saved to --cache (a later run loads
 // it); each variant then starts from that state, takes 200 DEM steps to warm up, and times --steps DEM steps.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
+// Each variant ends with a hash of the spheres' state: a change that should not move results must keep it.
 #include "coupling/coupled_world.h"
 #include "coupling/mixed_bed.h"
 #include "meshes/mesh_builder.h"
@@ -63,6 +64,20 @@ struct Bed {
         rigid.add_static_mesh(meshes::make_open_box_mesh(side_m, side_m, height_m, side_m), rigid.material_index("ground"), "box");
     }
 };
+
+/// FNV-1a over the spheres' positions and velocities: equal hashes say two builds stepped the bed to the same bits.
+std::uint64_t state_hash(const dem::ParticleStore& p)
+{
+    std::uint64_t h = 1469598103934665603ull;
+    auto add = [&](const std::vector<Vec3>& values) {
+        const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
+        for (std::size_t b = 0; b < values.size() * sizeof(Vec3); ++b) h = (h ^ bytes[b]) * 1099511628211ull;
+    };
+    add(p.position_m);
+    add(p.velocity_m_per_s);
+    add(p.angular_velocity_rad_per_s);
+    return h;
+}
 
 double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b)
 {
@@ -145,8 +160,8 @@ int main(int argc, char** argv)
     std::printf("\nbed from %s, dt = %g s, %d thread(s), %d timed DEM steps; seconds of wall time per simulated second:\n",
                 cache.c_str(), dt, threads, steps);
     std::printf("| variant | total | sphere-sphere | sphere-body and walls | neighbour search | integration | Bullet | "
-                "surface motion | x DEM-only | sphere-sphere contacts | sphere-body contacts |\n");
-    std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+                "surface motion | x DEM-only | sphere-sphere contacts | sphere-body contacts | state hash |\n");
+    std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
     double dem_only_total = 0.0;
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
     for (int n : variants) {
@@ -174,12 +189,12 @@ int main(int argc, char** argv)
         std::size_t body_contacts = 0;
         for (const ContactRecord& r : bed.dem.last_contact_records())
             if (bed.dem.is_mesh(r.surface_id)) ++body_contacts;
-        std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f | %zu | %zu |\n",
+        std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f | %zu | %zu | %016llx |\n",
                     n == 0 ? "DEM only" : ("n = " + std::to_string(n)).c_str(), wall * per, (p.pair_forces - p0.pair_forces) * per,
                     (p.wall_forces - p0.wall_forces) * per, (p.neighbour_search - p0.neighbour_search) * per,
                     (p.integration - p0.integration) * per, (bed.world.rigid_seconds() - r0) * per,
                     (bed.world.surface_seconds() - s0) * per, wall * per / dem_only_total, bed.dem.pair_contact_count(),
-                    body_contacts);
+                    body_contacts, static_cast<unsigned long long>(state_hash(bed.dem.particles())));
         std::fflush(stdout);
     }
     rusage u{};
