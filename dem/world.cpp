@@ -383,12 +383,20 @@ void World::finish_step(double dt_s)
         const WallContact& c = wall_contacts_[first];
         const double ratio = c.overlap_m / particles_.radius_m[c.particle];
         const Vec3 p = particles_.position_m[c.particle];
+        const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
+        // A body that moves far faster than anything drives it has run away: a light body answering its sphere
+        // contacts late (a coupling of several DEM steps per rigid-body step) pumps energy into them.
+        const std::string body = wall.mass_kg > 0.0
+            ? concat("; the body behind the wall (", wall.mass_kg, " kg) moves at ", norm(wall.velocity_at(c.point)),
+                     " m/s there: a light body coupled with several DEM steps per rigid-body step can run away against"
+                     " stiff sphere contacts, and fewer steps per rigid-body step (coupling.substeps) keep it stable")
+            : "";
         throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
                                      wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",
                                      " by ", ratio, " of its radius (limit ", settings_.max_overlap_ratio, ") at (",
                                      p.x, ", ", p.y, ", ", p.z, "), speed ", norm(particles_.velocity_m_per_s[c.particle]),
                                      " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
-                                     " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall"));
+                                     " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall", body));
     }
     if (max_overlap_ratio_ > settings_.max_overlap_ratio) fail_overlap();
 }

@@ -87,6 +87,32 @@ TEST_CASE("a diverging run stops with particle, time and a suggested step", "[de
     REQUIRE_THROWS_WITH(v.run_steps(100), Contains("particles 0 and 1") && Contains("overlap") && Contains("reduce step_s"));
 }
 
+TEST_CASE("a sphere overrun by a fast body names the body's mass and speed", "[dem][input][unit]")
+{
+    // A 50 kg plate under a resting sphere (0.01 m gap) is put 0.07 m higher at 500 m/s, as a runaway coupled body
+    // would be: the overlap is 0.6 of the radius, past the 0.5 limit, in the first step.
+    World w(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    w.add_particle({{1, 1, 0.11}, {}, {}, 0.1, 0});
+    const int plate = w.add_mesh(meshes::make_plate_mesh(2, 2, 2, 2), w.materials().index_of("bucket"), "plate");
+    w.prepare();
+    w.set_wall_mass_kg(plate, 50.0);
+    w.set_mesh_pose(plate, Mat3::identity(), {0, 0, 0.07}, {1, 1, 0.07}, {0, 0, 500}, {});
+    REQUIRE_THROWS_WITH(w.step(), Contains("overlaps wall 'plate'") && Contains("the body behind the wall (50 kg) moves at 500 m/s") &&
+                                      Contains("coupling.substeps"));
+    // an immovable wall (no mass) keeps the message about the step and the wall's speed only
+    World v(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    v.add_particle({{1, 1, 0.11}, {}, {}, 0.1, 0});
+    const int fixed = v.add_mesh(meshes::make_plate_mesh(2, 2, 2, 2), v.materials().index_of("bucket"), "fixed");
+    v.prepare();
+    v.set_mesh_pose(fixed, Mat3::identity(), {0, 0, 0.07}, {1, 1, 0.07}, {0, 0, 500}, {});
+    try {
+        v.step();
+        FAIL("the overlap was not caught");
+    } catch (const SimulationError& e) {
+        CHECK_THAT(e.what(), Contains("or slow the wall") && !Contains("body behind"));
+    }
+}
+
 TEST_CASE("missing, corrupt and degenerate mesh files are refused by name", "[meshes][input][unit]")
 {
     REQUIRE_THROWS_WITH(meshes::load_triangle_mesh("/nonexistent/bucket.stl"), Contains("/nonexistent/bucket.stl") && Contains("does not exist"));
