@@ -384,12 +384,14 @@ void World::finish_step(double dt_s)
         const double ratio = c.overlap_m / particles_.radius_m[c.particle];
         const Vec3 p = particles_.position_m[c.particle];
         const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
-        // A body that moves far faster than anything drives it has run away: a light body answering its sphere
-        // contacts late (a coupling of several DEM steps per rigid-body step) pumps energy into them.
+        // For a wall with a body behind it, the body's mass and speed there let the user tell a runaway body from a
+        // fast sphere: a light body answering its sphere contacts late (several DEM steps per rigid-body step) can
+        // pump energy into them.
         const std::string body = wall.mass_kg > 0.0
             ? concat("; the body behind the wall (", wall.mass_kg, " kg) moves at ", norm(wall.velocity_at(c.point)),
-                     " m/s there: a light body coupled with several DEM steps per rigid-body step can run away against"
-                     " stiff sphere contacts, and fewer steps per rigid-body step (coupling.substeps) keep it stable")
+                     " m/s there: if that is far faster than anything drives it, the body has run away (a light body"
+                     " coupled with several DEM steps per rigid-body step can, against stiff sphere contacts), and fewer"
+                     " steps per rigid-body step (coupling.substeps) keep it stable")
             : "";
         throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
                                      wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",
