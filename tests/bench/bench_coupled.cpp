@@ -6,10 +6,12 @@
 // The bed is filled loosely in a box, settled for --settle-s at n = 10 and saved to --cache (a later run loads
 // it); each variant then starts from that state, takes 200 DEM steps to warm up, and times --steps DEM steps.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
-// Each variant ends with a hash of the spheres' state: a change that should not move results must keep it.
+// Each variant ends with the spheres' state hash (the one summary.json gives): a change that should not move
+// results must keep it.
 #include "coupling/coupled_world.h"
 #include "coupling/mixed_bed.h"
 #include "meshes/mesh_builder.h"
+#include "scenario/runner.h"
 #include "tests/bench/options.h"
 
 #include <sys/resource.h>
@@ -64,20 +66,6 @@ struct Bed {
         rigid.add_static_mesh(meshes::make_open_box_mesh(side_m, side_m, height_m, side_m), rigid.material_index("ground"), "box");
     }
 };
-
-/// FNV-1a over the spheres' positions and velocities: equal hashes say two builds stepped the bed to the same bits.
-std::uint64_t state_hash(const dem::ParticleStore& p)
-{
-    std::uint64_t h = 1469598103934665603ull;
-    auto add = [&](const std::vector<Vec3>& values) {
-        const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-        for (std::size_t b = 0; b < values.size() * sizeof(Vec3); ++b) h = (h ^ bytes[b]) * 1099511628211ull;
-    };
-    add(p.position_m);
-    add(p.velocity_m_per_s);
-    add(p.angular_velocity_rad_per_s);
-    return h;
-}
 
 double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b)
 {
@@ -194,7 +182,7 @@ int main(int argc, char** argv)
                     (p.wall_forces - p0.wall_forces) * per, (p.neighbour_search - p0.neighbour_search) * per,
                     (p.integration - p0.integration) * per, (bed.world.rigid_seconds() - r0) * per,
                     (bed.world.surface_seconds() - s0) * per, wall * per / dem_only_total, bed.dem.pair_contact_count(),
-                    body_contacts, static_cast<unsigned long long>(state_hash(bed.dem.particles())));
+                    body_contacts, static_cast<unsigned long long>(scenario::particle_state_hash(bed.dem)));
         std::fflush(stdout);
     }
     rusage u{};
