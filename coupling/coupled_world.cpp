@@ -96,6 +96,10 @@ int CoupledWorld::couple(rigid::BodyId body, meshes::TriangleMesh surface, dem::
     spin_rad_.push_back({});
     force_sum_.push_back({});
     torque_sum_.push_back({});
+    Watch w;
+    w.velocity_m_per_s = s.velocity_m_per_s;
+    w.angular_velocity_rad_per_s = s.angular_velocity_rad_per_s;
+    watch_.push_back(w);
     return static_cast<int>(bodies_.size() - 1);
 }
 
@@ -107,7 +111,11 @@ rigid::BodyId CoupledWorld::add_rock(const rigid::ConvexPolyhedron& shape, doubl
                                              velocity_m_per_s, angular_velocity_rad_per_s);
     std::string name = rigid_.body_name(id);  // "rock 12" -> DEM wall "rock_12" (wall names are file-name safe)
     std::replace(name.begin(), name.end(), ' ', '_');
-    couple(id, shape.to_mesh(), dem_material, name);
+    const auto k = static_cast<std::size_t>(couple(id, shape.to_mesh(), dem_material, name));
+    // the shape is in its principal frame: its inertia about the centroid is diagonal there
+    const Mat3 inertia = shape.inertia_about_centroid(density_kg_per_m3);
+    const double mass = rigid_.mass_kg(id);
+    watch_[k].radius_of_gyration_m = {std::sqrt(inertia.m[0][0] / mass), std::sqrt(inertia.m[1][1] / mass), std::sqrt(inertia.m[2][2] / mass)};
     rocks_.push_back({id, shape, density_kg_per_m3, rigid_material, dem_material});
     return id;
 }
@@ -168,6 +176,10 @@ void CoupledWorld::write_state(StateWriter& out) const
     out.value<std::uint8_t>(started_ ? 1 : 0);
     out.value(rigid_seconds_);
     out.value(surface_seconds_);
+    out.array(watch_);
+    out.value<std::int32_t>(hold_steps_);
+    out.value(guarded_steps_);
+    out.value(runaways_caught_);
 }
 
 void CoupledWorld::read_state(StateReader& in)
@@ -190,6 +202,11 @@ void CoupledWorld::read_state(StateReader& in)
     started_ = in.value<std::uint8_t>() != 0;
     rigid_seconds_ = in.value<double>();
     surface_seconds_ = in.value<double>();
+    in.array(watch_);
+    if (watch_.size() != bodies_.size()) in.fail("runaway-guard records of another number of bodies");
+    hold_steps_ = in.value<std::int32_t>();
+    guarded_steps_ = in.value<std::uint64_t>();
+    runaways_caught_ = in.value<std::uint64_t>();
     checked_bodies_ = 0;  // checked again before the next step
 }
 
@@ -254,12 +271,12 @@ void CoupledWorld::start()
         torque_sum_[k] = dem_.wall_torque_N_m(bodies_[k].wall);
     }
     samples_ = 1;
+    initial_reaction_ = true;
     started_ = true;
 }
 
-void CoupledWorld::move_surfaces(double fraction)
+void CoupledWorld::move_surfaces(double fraction, double interval_s)
 {
-    const double interval = coupling_step_s();
     for_each_body(bodies_.size(), dem_.threads(), [&](std::size_t k) {
         const Pose& a = before_[k];
         const Pose& b = after_[k];
@@ -276,32 +293,73 @@ void CoupledWorld::move_surfaces(double fraction)
         const Mat3 rotation = turn * a.rotation;
         const Vec3 centre = a.centre_m + (b.centre_m - a.centre_m) * fraction;
         const Vec3 origin = centre + turn * (a.origin_m - a.centre_m);
-        dem_.set_mesh_pose(bodies_[k].wall, rotation, origin, centre, (b.centre_m - a.centre_m) * (1.0 / interval),
-                           spin * (1.0 / interval));
+        dem_.set_mesh_pose(bodies_[k].wall, rotation, origin, centre, (b.centre_m - a.centre_m) * (1.0 / interval_s),
+                           spin * (1.0 / interval_s));
     });
 }
 
-void CoupledWorld::step()
+void CoupledWorld::watch_for_runaways()
 {
-    if (checked_bodies_ != bodies_.size()) {
-        check_pairs();
-        checked_bodies_ = bodies_.size();
+    // Each rock's velocity change over the coupling step just done, as a 6-vector in m/s (the angular part in
+    // the principal frame, times the radius of gyration: its kinetic energy weighs as the linear part's). A
+    // streak counts the steps in a row in which the change turned by more than 120 degrees and grew.
+    bool caught = false;
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+        Watch& w = watch_[k];
+        if (w.radius_of_gyration_m == Vec3{}) continue;
+        const rigid::BodyState s = rigid_.state(bodies_[k].body);
+        const Vec3 change = s.velocity_m_per_s - w.velocity_m_per_s;
+        const Vec3 turn = after_[k].rotation.transposed() * (s.angular_velocity_rad_per_s - w.angular_velocity_rad_per_s);
+        const Vec3 angular_change{turn.x * w.radius_of_gyration_m.x, turn.y * w.radius_of_gyration_m.y, turn.z * w.radius_of_gyration_m.z};
+        const double size = std::sqrt(norm_squared(change) + norm_squared(angular_change));
+        const double before = std::sqrt(norm_squared(w.change_m_per_s) + norm_squared(w.angular_change_m_per_s));
+        const double along = dot(change, w.change_m_per_s) + dot(angular_change, w.angular_change_m_per_s);
+        if (before >= kRunawayFloor_m_per_s && size > before && along < -0.5 * size * before) {
+            ++w.streak;
+            w.growth *= size / before;
+        } else {
+            w.streak = 0;
+            w.growth = 1.0;
+        }
+        if (w.streak >= kRunawayStreak && w.growth >= kRunawayGrowth) {
+            caught = true;
+            w.streak = 0;
+            w.growth = 1.0;
+        }
+        w.velocity_m_per_s = s.velocity_m_per_s;
+        w.angular_velocity_rad_per_s = s.angular_velocity_rad_per_s;
+        w.change_m_per_s = change;
+        w.angular_change_m_per_s = angular_change;
     }
-    if (!started_) start();
+    if (caught) {
+        hold_steps_ = kRunawayHoldSteps;
+        ++runaways_caught_;
+    }
+}
 
+void CoupledWorld::exchange(int steps)
+{
     // 1. Bullet steps with the spheres' mean reaction from the last sub-steps (each body's own data: the
     // per-body loops run on the DEM's threads)
+    // The body receives in full the impulse the spheres received over the last exchange's sub-steps, sum x dt,
+    // spread over this step of steps x dt: the sub-steps' mean force when the two exchanges are equal, as
+    // they are unless the guard splits a coupling step. The first step holds the initial state's force.
     const int threads = dem_.threads();
+    const double scale = samples_ == 0 ? 0.0 : 1.0 / (initial_reaction_ ? samples_ : steps);
+    initial_reaction_ = false;
     for_each_body(bodies_.size(), threads, [&](std::size_t k) {
         CoupledBody& b = bodies_[k];
-        b.applied_force_N = samples_ > 0 ? force_sum_[k] * (1.0 / samples_) : Vec3{};
-        b.applied_torque_N_m = samples_ > 0 ? torque_sum_[k] * (1.0 / samples_) : Vec3{};
+        b.applied_force_N = force_sum_[k] * scale;
+        b.applied_torque_N_m = torque_sum_[k] * scale;
         if (b.dynamic) rigid_.apply_force_and_torque(b.body, b.applied_force_N, b.applied_torque_N_m);
         before_[k] = pose_of(b);
         force_sum_[k] = Vec3{};
         torque_sum_[k] = Vec3{};
     });
     samples_ = 0;
+    const double interval = dem_.step_s() * steps;
+    if (before_rigid_step_) before_rigid_step_(dem_.time_s() + interval);
+    rigid_.set_step_s(interval);
     auto mark = std::chrono::steady_clock::now();
     rigid_.step();
     auto now = std::chrono::steady_clock::now();
@@ -312,11 +370,10 @@ void CoupledWorld::step()
     });
 
     // 2. and 3. the DEM sub-steps, the surfaces moving from the old poses to the new ones
-    const int n = settings_.substeps;
     dem::World::StepHooks hooks;
     hooks.before_forces = [&](std::uint64_t s) {
         const auto start = std::chrono::steady_clock::now();
-        move_surfaces(static_cast<double>(s + 1) / n);
+        move_surfaces(static_cast<double>(s + 1) / steps, interval);
         surface_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     hooks.after_forces = [&](std::uint64_t) {
@@ -326,7 +383,27 @@ void CoupledWorld::step()
         });
         ++samples_;
     };
-    dem_.run_steps(static_cast<std::uint64_t>(n), hooks);
+    dem_.run_steps(static_cast<std::uint64_t>(steps), hooks);
+}
+
+void CoupledWorld::step()
+{
+    if (checked_bodies_ != bodies_.size()) {
+        check_pairs();
+        checked_bodies_ = bodies_.size();
+    }
+    if (!started_) start();
+
+    // one exchange of all the coupling step's DEM steps, or, while the runaway guard holds, one per DEM step
+    const int n = settings_.substeps;
+    if (n > 1 && hold_steps_ > 0) {
+        for (int s = 0; s < n; ++s) exchange(1);
+        --hold_steps_;
+        ++guarded_steps_;
+    } else {
+        exchange(n);
+    }
+    if (n > 1 && settings_.runaway_guard) watch_for_runaways();
 }
 
 void CoupledWorld::run_steps(std::uint64_t n)

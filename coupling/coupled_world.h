@@ -12,6 +12,7 @@
 #include "rigid/rigid_world.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,10 +24,24 @@ namespace dipper::coupling {
 /// n = 10 and diverged at n = 20; n = 5 makes Bullet's share of the step a fifth of n = 1's.
 inline constexpr int kDefaultSubsteps = 5;
 
+/// The runaway guard (CouplingSettings::runaway_guard, docs/coupling.md). A rock that answers stiff sphere contacts a coupling step late can
+/// gain speed from them: its velocity change flips direction every coupling step and grows. The guard
+/// watches each rock's velocity change over a coupling step (the rotation's scaled by the radius of
+/// gyration) and, once it has flipped and grown kRunawayStreak times in a row by kRunawayGrowth in all,
+/// from at least kRunawayFloor_m_per_s, runs the next kRunawayHoldSteps coupling steps with one DEM step per
+/// Bullet step, where the exchange is stable.
+inline constexpr int kRunawayStreak = 3;
+inline constexpr double kRunawayGrowth = 8.0;
+inline constexpr double kRunawayFloor_m_per_s = 0.01;
+inline constexpr int kRunawayHoldSteps = 50;
+
 struct CouplingSettings {
     /// DEM steps per rigid-body step (DESIGN 1.3). 1 exchanges forces every DEM step; larger values give
     /// Bullet one step of substeps x the DEM step with the mean reaction of the sub-steps.
     int substeps = kDefaultSubsteps;
+    /// The runaway guard (kRunawayStreak and below). Off by default: it changes a run's bits wherever it acts,
+    /// and in a falling column of the Table 1 mix it acts often (docs/coupling.md).
+    bool runaway_guard = false;
 };
 
 /// A rigid body the spheres touch, and what passed between the two at the last step.
@@ -59,6 +74,11 @@ struct RockRecord {
 /// Forces are thus always evaluated at a configuration both sides share; with substeps = 1 the exchange is
 /// the staggered scheme in which each impulse the spheres receive, the body receives too, so a closed
 /// system keeps its linear momentum to round-off (docs/coupling.md).
+///
+/// With substeps > 1 a light rock held by stiff, damped sphere contacts can run away (docs/coupling.md): the
+/// runaway guard above, where it is on, then makes each coupling step `substeps` exchanges of one DEM step
+/// for a while.
+/// A coupling step is always `substeps` DEM steps; momentum passes in full either way.
 class CoupledWorld {
 public:
     CoupledWorld(dem::World& dem, rigid::RigidWorld& rigid, CouplingSettings settings = {});
@@ -71,6 +91,10 @@ public:
     rigid::BodyId add_rock(const rigid::ConvexPolyhedron& shape, double density_kg_per_m3, int rigid_material,
                            dem::MaterialIndex dem_material, const Vec3& position_m, const Mat3& rotation = Mat3::identity(),
                            const Vec3& velocity_m_per_s = {}, const Vec3& angular_velocity_rad_per_s = {});
+
+    /// Called before each Bullet step with the time it steps to (a coupling step has several Bullet steps when
+    /// the guard splits it): the place to set kinematic bodies' poses from their prescribed motion.
+    void set_before_rigid_step(std::function<void(double t_end_s)> hook) { before_rigid_step_ = std::move(hook); }
 
     /// One coupling step (substeps DEM steps). Throws SimulationError with a diagnosis if either side blows up.
     void step();
@@ -94,6 +118,11 @@ public:
     rigid::RigidWorld& rigid() { return rigid_; }
     const dem::World& dem() const { return dem_; }
     const rigid::RigidWorld& rigid() const { return rigid_; }
+
+    /// Coupling steps the runaway guard has run as exchanges of one DEM step, and the times it was set off,
+    /// since the start.
+    std::uint64_t guarded_steps() const { return guarded_steps_; }
+    std::uint64_t runaways_caught() const { return runaways_caught_; }
 
     /// Wall-clock seconds in Bullet's steps and in moving the coupled surfaces (the DEM's own phases are in
     /// dem().phase_seconds()), summed since the start.
@@ -123,7 +152,11 @@ private:
     Pose pose_of(const CoupledBody& b) const;
     void start();
     void check_pairs() const;
-    void move_surfaces(double fraction);
+    void move_surfaces(double fraction, double interval_s);
+    /// One Bullet step and `steps` DEM steps (steps 1 and 2 of the class comment).
+    void exchange(int steps);
+    /// The runaway guard's watch over the rocks at the end of a coupling step.
+    void watch_for_runaways();
 
     dem::World& dem_;
     rigid::RigidWorld& rigid_;
@@ -133,7 +166,21 @@ private:
     std::vector<Pose> before_, after_;
     std::vector<Vec3> spin_rad_;             ///< rotation vector from `before_` to `after_`
     std::vector<Vec3> force_sum_, torque_sum_;
+    /// The runaway guard's record of each coupled body (rocks only; `radius_of_gyration_m` 0 for others):
+    /// velocities at the last coupling step's end, the velocity change over it, and the current streak.
+    struct Watch {
+        Vec3 radius_of_gyration_m;  ///< sqrt(I / m) along the principal axes
+        Vec3 velocity_m_per_s, angular_velocity_rad_per_s;
+        Vec3 change_m_per_s, angular_change_m_per_s;
+        std::int64_t streak = 0;  ///< 64 bits: no padding in the checkpoint's bytes
+        double growth = 1.0;
+    };
+    std::vector<Watch> watch_;
+    std::function<void(double)> before_rigid_step_;
+    std::int32_t hold_steps_ = 0;  ///< coupling steps still to run as exchanges of one DEM step
+    std::uint64_t guarded_steps_ = 0, runaways_caught_ = 0;
     int samples_ = 0;
+    bool initial_reaction_ = false;  ///< the sums hold the initial state's force, not an exchange's sub-steps
     double rigid_seconds_ = 0.0, surface_seconds_ = 0.0;
     bool started_ = false;
     std::size_t checked_bodies_ = 0;

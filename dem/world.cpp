@@ -390,8 +390,8 @@ void World::finish_step(double dt_s)
         const std::string body = wall.mass_kg > 0.0
             ? concat("; the body behind the wall (", wall.mass_kg, " kg) moves at ", norm(wall.velocity_at(c.point)),
                      " m/s there: if that is far faster than anything drives it, the body has run away (a light body"
-                     " coupled with several DEM steps per rigid-body step can, against stiff sphere contacts), and fewer"
-                     " steps per rigid-body step (coupling.substeps) keep it stable")
+                     " coupled with several DEM steps per rigid-body step can, against stiff sphere contacts): the runaway"
+                     " guard (coupling.runaway_guard: true) or fewer steps per rigid-body step (coupling.substeps) keep it stable")
             : "";
         throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
                                      wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",

@@ -100,6 +100,7 @@ const std::vector<KeySpec>& scenario_keys()
 
         {"coupling", "map", "{}", "spheres with rigid bodies (rocks, the shovel)"},
         {"coupling.substeps", "integer", "5", "DEM steps per rigid-body step (docs/coupling.md)"},
+        {"coupling.runaway_guard", "boolean", "false", "one DEM step per rigid-body step for a while when a rock runs away (docs/coupling.md)"},
 
         {"shovel", "map", "none", "the rope shovel (docs/machine.md), driven by motion curves"},
         {"shovel.position_m", "vector3", "[0, 0, 0]", "machine origin: on the ground, on the swing axis"},

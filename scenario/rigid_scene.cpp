@@ -62,7 +62,16 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
     rigid_->set_pair("rock", "truck", 0.85, 0.0);
     rigid_->set_pair("rock", "steel", 0.0, 0.0);
     for (const RockPairSpec& p : s.rock_pairs) rigid_->set_pair(p.a, p.b, p.friction, p.restitution);
-    coupled_ = std::make_unique<coupling::CoupledWorld>(dem, *rigid_, coupling::CouplingSettings{s.coupling_substeps});
+    coupled_ = std::make_unique<coupling::CoupledWorld>(dem, *rigid_, coupling::CouplingSettings{s.coupling_substeps, s.coupling_runaway_guard});
+    // moving walls: each Bullet step ends where the prescribed motion puts them at its end
+    coupled_->set_before_rigid_step([this](double t_end_s) {
+        for (const auto& [body, motion] : moving_meshes_) {
+            Mat3 r;
+            Vec3 t;
+            motion.pose(t_end_s, r, t);
+            rigid_->set_kinematic_pose(body, r, t);
+        }
+    });
     bool rocks = false;
     for (const FillSpec& f : s.fills) rocks = rocks || !f.rocks.empty();
 
@@ -293,14 +302,6 @@ void RigidScene::check_tunnelling() const
 
 void RigidScene::step()
 {
-    // moving walls: Bullet's step ends at t + the coupling step, where the prescribed motion puts them
-    const double t_next = coupled_->time_s() + coupled_->coupling_step_s();
-    for (const auto& [body, motion] : moving_meshes_) {
-        Mat3 r;
-        Vec3 t;
-        motion.pose(t_next, r, t);
-        rigid_->set_kinematic_pose(body, r, t);
-    }
     coupled_->step();
     check_tunnelling();
     const double dt = coupled_->coupling_step_s();

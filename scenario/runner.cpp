@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "dipper-checkpoint 2";
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 3";
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int signal) { g_signal = signal; }
@@ -612,6 +612,8 @@ private:
     {
         const RigidScene& r = *rigid_;
         out << ",\n  \"rocks\": " << r.coupled().rocks().size() << ",\n  \"rock_kinetic_energy_J\": " << json_number(r.rock_kinetic_energy_J());
+        out << ",\n  \"runaways_caught\": " << r.coupled().runaways_caught() << ",\n  \"guarded_coupling_steps\": "
+            << r.coupled().guarded_steps();
         if (r.has_shovel()) {
             const BucketContents b = r.bucket();
             out << ",\n  \"bucket_mass_kg\": " << json_number(b.mass_kg) << ",\n  \"fill_factor\": " << json_number(b.fill_factor)

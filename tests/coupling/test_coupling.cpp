@@ -224,8 +224,8 @@ TEST_CASE("a colliding cloud of spheres and rocks keeps its momentum", "[couplin
         const double dp = norm(s->world.linear_momentum_kg_m_per_s() - p0) / scale;
         const double dl = norm(s->world.angular_momentum_kg_m2_per_s() - l0) / (scale * 1.5);
         const double e1 = s->world.kinetic_energy_J();
-        std::printf("  n = %2d  %.2e  %.2e  %.4f  (peak sphere-rock %zu, sphere-sphere %zu)\n", n, dp, dl, e1 / e0,
-                    peak_wall, peak_pair);
+        std::printf("  n = %2d  %.2e  %.2e  %.4f  (peak sphere-rock %zu, sphere-sphere %zu; runaway guard set off %llu times)\n", n,
+                    dp, dl, e1 / e0, peak_wall, peak_pair, static_cast<unsigned long long>(s->world.runaways_caught()));
         CHECK(dp < 1e-13);
         CHECK(dl < 5e-5);
         CHECK(e1 < e0);  // damped contacts only take energy out
@@ -453,4 +453,47 @@ TEST_CASE("rebound of a sphere from a free rock against the exact solution, for 
     CHECK(added[1] > 0.05);
     CHECK(added[1] < 0.2);
     CHECK(added[2] > added[1]);
+}
+
+
+TEST_CASE("a light rock buried in spheres runs away at n = 5; the runaway guard carries it through", "[coupling][unit]")
+{
+    // A 0.35 m cube of 12.9 kg (density 300 kg/m^3, lighter than one 14.75 kg sphere) lies on a bed of
+    // 200 mm spheres and is buried under 850 kg more. At n = 5 the rock answers its stiff, damped sphere
+    // contacts a coupling step late; its velocity change flips and grows each coupling step until a sphere
+    // overlaps it past the limit (measured: t = 1.38 s). With the guard, the flips are caught and the rock
+    // answers them at every DEM step for a while: the run goes on to 2.5 s. Also checked: the rock stays in
+    // the box and under the spheres (the guard's exchanges move it as any other, no jump).
+    std::printf("buried light rock, n = 5: runaway guard off, on\n");
+    for (bool guard : {false, true}) {
+        auto s = make_scene(5, {0.0, 0.0, -9.81}, dem::MaterialTable::aitik_copper_ore(), guard);
+        settle_bed(s->dem, 0.8, 850.0, 1.0);
+        const rigid::BodyId rock = s->world.add_rock(cube(0.35), 300.0, s->rigid.material_index("rock"),
+                                                     s->dem.materials().index_of("rock"),
+                                                     {0.0, 0.0, bed_top_m(s->dem) + 0.175 + 0.005});
+        const double top = bed_top_m(s->dem) + 0.4;
+        dem::fill_random(s->dem, dem::BoxRegion({-0.4, -0.4, top}, {0.4, 0.4, top + 1.5}), {{{kSphereRadius, 1.0}}},
+                         s->dem.materials().index_of("ore"), 850.0, 9);
+        std::string stopped;
+        try {
+            while (s->world.time_s() < 2.5) s->world.step();
+        } catch (const SimulationError& e) {
+            stopped = e.what();
+        }
+        const Vec3 x = s->rigid.state(rock).position_m;
+        std::printf("  guard %-3s  t = %.3f s  caught %llu, guarded coupling steps %llu, rock at (%.2f, %.2f, %.2f) m%s\n",
+                    guard ? "on" : "off", s->world.time_s(), static_cast<unsigned long long>(s->world.runaways_caught()),
+                    static_cast<unsigned long long>(s->world.guarded_steps()), x.x, x.y, x.z, stopped.empty() ? "" : ": stopped");
+        if (!guard) {
+            CHECK(stopped.find("overlaps wall 'rock_") != std::string::npos);  // the rock ran away
+            CHECK(s->world.runaways_caught() == 0);
+            continue;
+        }
+        CHECK(stopped.empty());
+        CHECK(s->world.runaways_caught() > 0);
+        CHECK(s->world.guarded_steps() >= s->world.runaways_caught());
+        CHECK(std::abs(x.x) < 0.4);
+        CHECK(std::abs(x.y) < 0.4);
+        CHECK(x.z < bed_top_m(s->dem));
+    }
 }

@@ -76,7 +76,7 @@ shovel: {motion: held.csv, element_size_m: 0.3}
 TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the key", "[scenario][shovel]")
 {
     const Scenario s = parse_scenario(base("shovel: {rake_angle_deg: 59.8, wear_bars: diagonal, start_s: 1.5}\n"
-                                           "wear:\n  - {part: dipper, constant: 2.0e-12}\ncoupling: {substeps: 3}\n"),
+                                           "wear:\n  - {part: dipper, constant: 2.0e-12}\ncoupling: {substeps: 3, runaway_guard: true}\n"),
                                       "case.yaml", ".");
     REQUIRE(s.shovel.has_value());
     CHECK(s.shovel->rake_angle_deg == 59.8);
@@ -85,6 +85,8 @@ TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the
     CHECK(s.shovel->motion == "default_cycle");
     CHECK(s.shovel->bulk_density_kg_per_m3 == 1903.0);
     CHECK(s.coupling_substeps == 3);
+    CHECK(s.coupling_runaway_guard);
+    CHECK_FALSE(parse_scenario(base(""), "case.yaml", ".").coupling_runaway_guard);  // off unless asked for
     REQUIRE(s.wear.size() == 1);
     CHECK(s.wear[0].law == "force_work");
     CHECK(s.wear[0].smoothing_iterations == 2);
@@ -142,6 +144,8 @@ TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the
     CHECK_THAT(e, Catch::Contains("meshes[0].file: got neither file nor part"));
     e = error_of(base("meshes:\n  - {name: t, part: crusher, material: truck}\n"));
     CHECK_THAT(e, Catch::Contains("meshes[0].part: got \"crusher\"; expected truck_body, feeder_pan or feeder_bin"));
+    e = error_of(base("coupling: {runaway_guard: yes please}\n"));
+    CHECK_THAT(e, Catch::Contains("coupling.runaway_guard") && Catch::Contains("yes please") && Catch::Contains("true or false"));
     e = error_of(base("coupling: {substeps: 0}\n"));
     CHECK_THAT(e, Catch::Contains("coupling.substeps: got 0"));
 
