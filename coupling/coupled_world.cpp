@@ -339,11 +339,11 @@ void CoupledWorld::watch_for_runaways()
 
 void CoupledWorld::exchange(int steps)
 {
-    // 1. Bullet steps with the spheres' mean reaction from the last sub-steps (each body's own data: the
-    // per-body loops run on the DEM's threads)
-    // The body receives in full the impulse the spheres received over the last exchange's sub-steps, sum x dt,
-    // spread over this step of steps x dt: the sub-steps' mean force when the two exchanges are equal, as
-    // they are unless the guard splits a coupling step. The first step holds the initial state's force.
+    // 1. Bullet steps with the spheres' reaction from the last exchange's sub-steps. The body receives in full
+    // the impulse the spheres received there, sum x dt, spread over this step of steps x dt: the sub-steps'
+    // mean force when the two exchanges are equally long, as they are except where the runaway guard starts
+    // or ends a hold. The first step holds the initial state's force. (The per-body loops touch each body's
+    // own data and run on the DEM's threads.)
     const int threads = dem_.threads();
     const double scale = samples_ == 0 ? 0.0 : 1.0 / (initial_reaction_ ? samples_ : steps);
     initial_reaction_ = false;

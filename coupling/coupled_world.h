@@ -32,7 +32,7 @@ inline constexpr int kDefaultSubsteps = 5;
 /// Bullet step, where the exchange is stable.
 inline constexpr int kRunawayStreak = 3;
 inline constexpr double kRunawayGrowth = 8.0;
-inline constexpr double kRunawayFloor_m_per_s = 0.01;
+inline constexpr double kRunawayFloor_m_per_s = 0.1;
 inline constexpr int kRunawayHoldSteps = 50;
 
 struct CouplingSettings {

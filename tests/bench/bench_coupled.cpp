@@ -2,7 +2,7 @@
 // coupling sub-step counts n, against the same bed stepped by the DEM alone (rocks held as fixed surfaces).
 // Spheres 200 mm; rocks of Table 1's classes in Table 1's mass ratios among themselves; Aitik ore (Table 2).
 // Usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]
-//                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet]
+//                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]
 // The bed is filled loosely in a box, settled for --settle-s at n = 10 and saved to --cache (a later run loads
 // it); each variant then starts from that state, takes 200 DEM steps to warm up, and times --steps DEM steps.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
@@ -10,6 +10,7 @@
 // results must keep it.
 #include "coupling/coupled_world.h"
 #include "coupling/mixed_bed.h"
+#include "core/errors.h"
 #include "meshes/mesh_builder.h"
 #include "scenario/runner.h"
 #include "tests/bench/options.h"
@@ -34,7 +35,7 @@ struct Bed {
     dem::World dem;
     rigid::RigidWorld rigid;
     coupling::CoupledWorld world;
-    Bed(double dt, int threads, int substeps, bool bullet_pairs)
+    Bed(double dt, int threads, int substeps, bool bullet_pairs, bool runaway_guard = false)
         : dem(dem::MaterialTable::aitik_copper_ore(), [&] {
               dem::WorldSettings s;
               s.step_s = dt;
@@ -48,7 +49,7 @@ struct Bed {
               s.threads = threads;
               return s;
           }()),
-          world(dem, rigid, coupling::CouplingSettings{substeps})
+          world(dem, rigid, coupling::CouplingSettings{substeps, runaway_guard})
     {
         rigid::add_aitik_copper_ore_materials(rigid);
     }
@@ -79,10 +80,10 @@ int main(int argc, char** argv)
     int spheres = 20000, rocks = 1000, threads = 1, steps = 400;
     double dt = 5e-5, settle_s = 0.6;
     std::string cache, substeps_list = "1,5,10,20";
-    std::string pairs = "dipper";
+    std::string pairs = "dipper", guard = "off";
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
-        "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet]\n";
+        "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n";
     const int status = bench::read_options(argc, argv, usage, [&](const std::string& key, const char* value) {
         if (key == "--spheres") spheres = std::atoi(value);
         else if (key == "--rocks") rocks = std::atoi(value);
@@ -93,12 +94,17 @@ int main(int argc, char** argv)
         else if (key == "--substeps") substeps_list = value;
         else if (key == "--cache") cache = value;
         else if (key == "--pairs") pairs = value;
+        else if (key == "--runaway-guard") guard = value;
         else return false;
         return true;
     });
     if (status >= 0) return status;
     if (pairs != "dipper" && pairs != "bullet") {
         std::fprintf(stderr, "--pairs is '%s'; expected dipper or bullet\n", pairs.c_str());
+        return 2;
+    }
+    if (guard != "on" && guard != "off") {
+        std::fprintf(stderr, "--runaway-guard is '%s'; expected on or off\n", guard.c_str());
         return 2;
     }
     const bool bullet_pairs = pairs == "bullet";
@@ -153,7 +159,7 @@ int main(int argc, char** argv)
     double dem_only_total = 0.0;
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
     for (int n : variants) {
-        Bed bed(dt, threads, std::max(n, 1), bullet_pairs);
+        Bed bed(dt, threads, std::max(n, 1), bullet_pairs, guard == "on");
         bed.add_box(side, height + 1.0);
         coupling::load_state(bed.world, cache);
         const int warm = 200;
@@ -163,13 +169,30 @@ int main(int argc, char** argv)
             else
                 for (int k = 0; k < dem_steps / n; ++k) bed.world.step();
         };
-        run(warm);
-        const dem::PhaseSeconds p0 = bed.dem.phase_seconds();
-        const double r0 = bed.world.rigid_seconds(), s0 = bed.world.surface_seconds();
-        const double sim0 = bed.dem.time_s();
-        const auto t0 = std::chrono::steady_clock::now();
-        run(steps);
-        const double wall = seconds(t0, std::chrono::steady_clock::now());
+        const std::string name = n == 0 ? "DEM only" : "n = " + std::to_string(n);
+        auto guard_line = [&] {
+            if (guard == "on" && n > 1)
+                std::printf("  %s: runaway guard set off %llu times, %llu coupling steps guarded\n", name.c_str(),
+                            static_cast<unsigned long long>(bed.world.runaways_caught()),
+                            static_cast<unsigned long long>(bed.world.guarded_steps()));
+        };
+        dem::PhaseSeconds p0;
+        double r0 = 0.0, s0 = 0.0, sim0 = 0.0, wall = 0.0;
+        try {
+            run(warm);
+            p0 = bed.dem.phase_seconds();
+            r0 = bed.world.rigid_seconds();
+            s0 = bed.world.surface_seconds();
+            sim0 = bed.dem.time_s();
+            const auto t0 = std::chrono::steady_clock::now();
+            run(steps);
+            wall = seconds(t0, std::chrono::steady_clock::now());
+        } catch (const SimulationError& e) {
+            std::printf("| %s | stopped at step %llu: %s |\n", name.c_str(), static_cast<unsigned long long>(bed.dem.step_count()), e.what());
+            guard_line();
+            std::fflush(stdout);
+            continue;
+        }
         const double sim = bed.dem.time_s() - sim0;
         const dem::PhaseSeconds& p = bed.dem.phase_seconds();
         const double per = 1.0 / sim;
@@ -177,12 +200,12 @@ int main(int argc, char** argv)
         std::size_t body_contacts = 0;
         for (const ContactRecord& r : bed.dem.last_contact_records())
             if (bed.dem.is_mesh(r.surface_id)) ++body_contacts;
-        std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f | %zu | %zu | %016llx |\n",
-                    n == 0 ? "DEM only" : ("n = " + std::to_string(n)).c_str(), wall * per, (p.pair_forces - p0.pair_forces) * per,
+        std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f | %zu | %zu | %016llx |\n", name.c_str(), wall * per, (p.pair_forces - p0.pair_forces) * per,
                     (p.wall_forces - p0.wall_forces) * per, (p.neighbour_search - p0.neighbour_search) * per,
                     (p.integration - p0.integration) * per, (bed.world.rigid_seconds() - r0) * per,
                     (bed.world.surface_seconds() - s0) * per, wall * per / dem_only_total, bed.dem.pair_contact_count(),
                     body_contacts, static_cast<unsigned long long>(scenario::particle_state_hash(bed.dem)));
+        guard_line();
         std::fflush(stdout);
     }
     rusage u{};
