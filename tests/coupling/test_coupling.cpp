@@ -456,7 +456,7 @@ TEST_CASE("rebound of a sphere from a free rock against the exact solution, for 
 }
 
 
-TEST_CASE("a light rock buried in spheres runs away at n = 5; the runaway guard carries it through", "[coupling][unit]")
+TEST_CASE("a light rock buried in spheres runs away at n = 5 and the runaway guard carries it through", "[coupling][unit]")
 {
     // A 0.35 m cube of 12.9 kg (density 300 kg/m^3, lighter than one 14.75 kg sphere) lies on a bed of
     // 200 mm spheres and is buried under 850 kg more. At n = 5 the rock answers its stiff, damped sphere

@@ -86,7 +86,7 @@ TEST_CASE("inertia of a cube and a regular tetrahedron equal the closed forms", 
     }
 }
 
-TEST_CASE("rock meshes: convex closed meshes are accepted; non-convex, open or flat ones are errors", "[rigid][rocks][unit][bad_input]")
+TEST_CASE("rock meshes: convex closed meshes are accepted, non-convex, open or flat ones are errors", "[rigid][rocks][unit][bad_input]")
 {
     CHECK_NOTHROW(cube(1.0));
     // a box whose top centre is pushed down: the top is a dent, not convex

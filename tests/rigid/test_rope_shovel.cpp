@@ -163,7 +163,7 @@ TEST_CASE("a rope never pushes: paid out beyond reach, the dipper rests on the g
     CHECK(w.shovel_reading().rope_length_m[0] < hoist - 0.1);  // resting on the ground, the rope hangs slack
 }
 
-TEST_CASE("the default cycle: three passes in 138 s with 15 s digs; the shovel follows it", "[rigid][shovel][unit]")
+TEST_CASE("the default cycle: three passes in 138 s with 15 s digs, the shovel follows it", "[rigid][shovel][unit]")
 {
     const meshes::Dipper dipper = meshes::make_dipper({});
     ShovelGeometry g;
@@ -449,7 +449,7 @@ TEST_CASE("propel: the machine moves along its heading as the curve says, and th
     CHECK_THROWS_WITH(default_loading_cycle(g, dipper, -1.0), Catch::Contains("advance_per_pass_m = -1"));
 }
 
-TEST_CASE("a wall that does not block the machine leaves the shovel as if it were not there; one that does, stops it",
+TEST_CASE("a wall that does not block the machine leaves the shovel as if it were not there, one that does, stops it",
           "[rigid][shovel][unit]")
 {
     // the dipper holds a pose with a fixed box through its middle: let through, the drive forces equal

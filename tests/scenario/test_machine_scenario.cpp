@@ -576,7 +576,7 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and fo
     fs::remove_all(dir);
 }
 
-TEST_CASE("measured wear: compared and calibrated at the end of a run; points off the part are refused before it",
+TEST_CASE("measured wear: compared and calibrated at the end of a run, points off the part are refused before it",
           "[scenario][wear]")
 {
     const std::string file = std::string(DIPPER_SOURCE_DIR) + "/tests/data/scenarios/wear_floor.yaml";

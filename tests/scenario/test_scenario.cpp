@@ -188,7 +188,7 @@ TEST_CASE("a mesh file that cannot be read names the scenario entry", "[scenario
     }
 }
 
-TEST_CASE("materials from the file extend the preset; missing pair coefficients are named", "[scenario]")
+TEST_CASE("materials from the file extend the preset, missing pair coefficients are named", "[scenario]")
 {
     const std::string extra = R"(materials:
   add:

@@ -117,7 +117,7 @@ TEST_CASE("comparison statistics: errors, relative errors and correlation of a k
     CHECK(summarize(cs).correlation == Approx(-0.5).epsilon(1e-12));
 }
 
-TEST_CASE("sections: a polyline across the surface samples the map; measured points near it are placed on it",
+TEST_CASE("sections: a polyline across the surface samples the map, measured points near it are placed on it",
           "[wear][validation][unit]")
 {
     const WearSurface s = worn_plate(1e-12);
