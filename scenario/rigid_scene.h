@@ -83,6 +83,9 @@ public:
     const rigid::RigidWorld& rigid() const { return *rigid_; }
 
     bool has_shovel() const { return dipper_body_ >= 0; }
+    /// The shovel's dipper and door in the rigid world (-1 without a shovel).
+    rigid::BodyId dipper_body() const { return dipper_body_; }
+    rigid::BodyId door_body() const { return door_body_; }
     const meshes::Dipper& dipper() const { return dipper_; }
     const rigid::ShovelReading& reading() const;
     /// Resultant force of the spheres and rocks on dipper and door in the last step, N (0 without a shovel).
