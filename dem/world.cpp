@@ -931,11 +931,17 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         push_triangle_hit(k, mw, xb, cp);
     }
 
-    // One contact per touched feature. A face hit always counts. An edge or vertex hit counts only if no
-    // triangle that shares that edge or vertex is strictly closer (then the feature itself is the
-    // closest point of its neighbourhood: a convex edge or corner), and a feature shared by several
-    // triangles counts once. Every triangle closer than a hit is itself a hit (it lies within r), so
-    // the check over the hits is exact.
+    // One contact per point of the surface that is locally closest to the centre:
+    // - hits at the same point (closer than 1e-9 r) are one contact, however the triangles there classify it: a
+    //   feature shared by several triangles, or a centre whose projection lies within round-off of an edge or
+    //   vertex (a turned mesh, a sphere placed over a node), which can fall inside one triangle and on the border
+    //   of the next. The first hit there stays (its own decision is final, taken over all the hits);
+    // - a face hit counts;
+    // - an edge or vertex hit counts only if every triangle that shares that edge or vertex has its closest
+    //   point there too. A triangle's closest point is unique, so one elsewhere on a triangle that holds this
+    //   point is strictly closer, and this point is not a local minimum (however small the difference in
+    //   overlap: a centre 1 um beside an edge of a flat plate). Every triangle that holds the point lies within
+    //   r, so it is among the hits, and the check over the hits is exact.
     // A lone mesh hit has nothing to be compared with (the common case: one face of a rock). The ids of the
     // touched features are looked up only here.
     const int hit_count = static_cast<int>(hits.size());
@@ -944,23 +950,23 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         const auto local = static_cast<std::size_t>(h.local_index);
         return h.feature == meshes::Feature::Edge ? ids.edges[local] : ids.vertices[local];
     };
+    const double same_point2 = 1e-18 * r * r;
     for (int a = first_mesh_hit; a < hit_count && hit_count - first_mesh_hit > 1; ++a) {
         WallHit& h = hits[static_cast<std::size_t>(a)];
-        if (h.feature == meshes::Feature::Face) continue;
-        const double tolerance = 1e-9 * r;
+        for (int b = first_mesh_hit; b < a && h.keep; ++b) {
+            const WallHit& o = hits[static_cast<std::size_t>(b)];
+            if (o.keep && o.wall == h.wall && norm_squared(o.point - h.point) < same_point2) h.keep = false;
+        }
+        if (!h.keep || h.feature == meshes::Feature::Face) continue;
         const std::uint32_t id = feature_id(h);
         for (int b = first_mesh_hit; b < hit_count && h.keep; ++b) {
             const WallHit& o = hits[static_cast<std::size_t>(b)];
-            if (b == a || o.wall != h.wall) continue;
-            if (o.feature == h.feature && feature_id(o) == id) {
-                if (b < a) h.keep = false;  // the same feature seen from another triangle: the first one stays
-                continue;
-            }
+            if (b == a || o.wall != h.wall || norm_squared(o.point - h.point) < same_point2) continue;
             const TriangleIds& other = candidate_ids_[o.candidate];
             const bool shares = h.feature == meshes::Feature::Edge
                                     ? (other.edges[0] == id || other.edges[1] == id || other.edges[2] == id)
                                     : (other.vertices[0] == id || other.vertices[1] == id || other.vertices[2] == id);
-            if (shares && o.overlap > h.overlap + tolerance) h.keep = false;
+            if (shares) h.keep = false;
         }
     }
 

@@ -52,6 +52,33 @@ TEST_CASE("a sphere on a shared vertex, edge or face of a flat mesh gets exactly
     }
 }
 
+TEST_CASE("a sphere on a shared vertex or edge of a turned mesh gets exactly one contact", "[dem][walls][unit]")
+{
+    // The plate of the test above turned and moved, as a machine part is: the sphere's centre, taken into the
+    // mesh's frame, lands within round-off of the vertex or edge, and each triangle around it may then find its
+    // closest point inside itself (a face) or on its border. One point of the surface is one contact whichever
+    // way the triangles classify it (counted without that rule, the shared vertex has five).
+    const meshes::TriangleMesh plate = meshes::make_plate_mesh(2.0, 2.0, 4, 4);
+    const Mat3 turn = rotation_about_axis(normalized(Vec3{0.3, -1.0, 0.4}), 0.47);
+    const Vec3 shift{21.3, -4.7, 12.9};
+    struct Place { const char* what; double x, y; };
+    for (const Place& place : {Place{"shared vertex", 1.0, 1.0}, Place{"diagonal edge", 0.25, 0.25},
+                               Place{"axis-aligned edge", 0.7, 1.0}, Place{"face", 0.3, 0.1}}) {
+        CAPTURE(place.what);
+        World w = sticky_world();
+        const int id = w.add_mesh(plate, 1, "plate");
+        w.set_mesh_pose(id, turn, shift, shift, {}, {});
+        const double r = 0.1, overlap = 1e-4;
+        w.add_particle({shift + turn * Vec3{place.x, place.y, r - overlap}, {}, {}, r, 0});
+        w.step();
+        CHECK(w.wall_contact_count() == 1);
+        // and it pushes with one contact's force, at the first step k overlap (no relative velocity yet)
+        const auto& records = w.last_contact_records();
+        REQUIRE(!records.empty());
+        CHECK(norm(records[0].normal_world - turn * Vec3{0.0, 0.0, 1.0}) < 1e-9);
+    }
+}
+
 TEST_CASE("a sphere on a convex edge or corner of a box gets one contact, in a concave corner two", "[dem][walls][unit]")
 {
     const meshes::TriangleMesh box = meshes::make_box_mesh({0.0, 0.0, -1.0}, {1.0, 1.0, 0.0});
