@@ -20,7 +20,7 @@ def sweep_report(folder):
     columns = list(rows[0].keys()) if rows else []
     parameters = columns[1:columns.index("status")] if "status" in columns else []
     shown = parameters + [c for c in ("status", "pass1_mass_kg", "pass1_fill_factor", "pass1_mean_dig_force_N",
-                                      "pass1_mean_interface_force_N", "repose_angle_deg", "wear_dipper_m3", "wear_dipper_bottom_m3", "wear_dipper_bars_m3", "mass_kg")
+                                      "pass1_mean_interface_force_N", "pass1_mean_interface_force_without_lip_N", "repose_angle_deg", "wear_dipper_m3", "wear_dipper_bottom_m3", "wear_dipper_bars_m3", "mass_kg")
                           if c in columns]
     lines = [f"# Sweep: {os.path.basename(os.path.abspath(folder))}", "", "| " + " | ".join(shown) + " |",
              "|" + " --- |" * len(shown)]
@@ -37,6 +37,7 @@ def sweep_report(folder):
     quantities = [("pass1_mass_kg", "mass in the dipper, pass 1 [t]", 1e-3),
                   ("pass1_mean_dig_force_N", "mean dig force, pass 1 [MN]", 1e-6),
                   ("pass1_mean_interface_force_N", "mean interface force, pass 1 [MN]", 1e-6),
+                  ("pass1_mean_interface_force_without_lip_N", "the same without the lip, pass 1 [MN]", 1e-6),
                   ("wear_dipper_bottom_m3", "wear of the dipper's bottom [mm3]", 1e9)]
     quantities = ([q for q in quantities if q[0] in columns] or
                   ([("repose_angle_deg", "angle of repose [deg]", 1.0)] if "repose_angle_deg" in columns else []) or
@@ -252,17 +253,20 @@ if "repose_angle_deg" in summary:
         lines.append("| angle of repose | none: no pile slope in the probe's window |")
 if "passes" in summary:
     lines += ["", "| pass | dig phase [s] | mass when the door opened [t] | fill factor | mean dig force over the dig [MN] | peak [MN] "
-              "| mean interface force over the dig [MN] | peak [MN] |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "| mean interface force over the dig [MN] | peak [MN] | mean without the lip [MN] | peak [MN] |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for p in summary["passes"]:
         lines.append(f"| {p['pass']} | {g(p.get('dig_start_s', p['start_s']))} to {g(p['dig_end_s'])} | {g(p['mass_kg'], 1e-3)} | "
                      f"{g(p['fill_factor'])} | {g(p['mean_dig_force_N'], 1e-6)} | {g(p['peak_dig_force_N'], 1e-6)} | "
                      f"{g(p['mean_interface_force_N'], 1e-6) if 'mean_interface_force_N' in p else '–'} | "
-                     f"{g(p['peak_interface_force_N'], 1e-6) if 'peak_interface_force_N' in p else '–'} |")
+                     f"{g(p['peak_interface_force_N'], 1e-6) if 'peak_interface_force_N' in p else '–'} | "
+                     f"{g(p['mean_interface_force_without_lip_N'], 1e-6) if 'mean_interface_force_without_lip_N' in p else '–'} | "
+                     f"{g(p['peak_interface_force_without_lip_N'], 1e-6) if 'peak_interface_force_without_lip_N' in p else '–'} |")
     if not summary["passes"]:
-        lines.append("| (no dump yet) | | | | | | | |")
+        lines.append("| (no dump yet) | | | | | | | | | |")
     lines += ["", "Dig force: sqrt(F_crowd² + F_hoist²) of the drives (thesis eq. 11). Interface force: the resultant of the "
-              "material's force on dipper and door (thesis Paper B Fig. 19)."]
+              "material's force on dipper and door; without the lip: the same less the force on the lip and its teeth, what thesis Paper B "
+              "Fig. 19 plots (\"acting on the bucket (excluding lip)\")."]
 for part, w in summary.get("wear", {}).items():
     lines += ["", f"Wear of {part} ({w['law']}, constant {g(w['constant'])}): volume {g(w['volume_m3'])} m³, "
               f"deepest {g(w['max_depth_mm'])} mm."]

@@ -448,6 +448,28 @@ Vec3 RigidWorld::contact_force_N(BodyId id) const
     return impl_->contact_force[static_cast<std::size_t>(id)];
 }
 
+std::vector<RigidWorld::PointForce> RigidWorld::contact_point_forces(BodyId id) const
+{
+    impl_->body(id, "contact_point_forces");
+    const double dt = impl_->settings.step_s;
+    std::vector<PointForce> out;
+    btDispatcher& d = impl_->dispatcher;
+    for (int q = 0; q < d.getNumManifolds(); ++q) {
+        const btPersistentManifold* m = d.getManifoldByIndexInternal(q);
+        const bool is_a = m->getBody0()->getUserIndex2() == id, is_b = m->getBody1()->getUserIndex2() == id;
+        if (!is_a && !is_b) continue;
+        for (int k = 0; k < m->getNumContacts(); ++k) {
+            const btManifoldPoint& p = m->getContactPoint(k);
+            // the same force as contact_force_N's: on A, its opposite on B
+            const Vec3 on_a = (from_bt(p.m_normalWorldOnB) * p.m_appliedImpulse + from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
+                               from_bt(p.m_lateralFrictionDir2) * p.m_appliedImpulseLateral2) * (1.0 / dt);
+            if (is_a) out.push_back({from_bt(p.getPositionWorldOnA()), on_a});
+            if (is_b) out.push_back({from_bt(p.getPositionWorldOnB()), -on_a});
+        }
+    }
+    return out;
+}
+
 std::size_t RigidWorld::contact_point_count() const { return pair_counts().contact_points; }
 
 RigidWorld::PairCounts RigidWorld::pair_counts() const

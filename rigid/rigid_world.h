@@ -148,6 +148,13 @@ public:
     // ---- contacts of the last step
     /// Sum of contact forces (impulses / step) on a body during the last step, N.
     Vec3 contact_force_N(BodyId body) const;
+    /// Where a contact point of the last step acts on a body, and its force on that body (impulse / step).
+    struct PointForce {
+        Vec3 point_m, force_N;
+    };
+    /// The contact points that make up contact_force_N(body), each with its force, the point on `body`. Keeps
+    /// no state: call it as often as needed.
+    std::vector<PointForce> contact_point_forces(BodyId body) const;
     /// Every contact point on `surface` during the last step, as a record: the point on the surface, the
     /// normal from the surface towards the other body, normal and friction force (impulse / step), the
     /// other body's contact point displacement relative to the surface over the step, and the surface's

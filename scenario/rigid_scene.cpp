@@ -166,7 +166,21 @@ RigidScene::RigidScene(const Scenario& s, dem::World& dem) : dem_(&dem)
         const dem::MaterialIndex steel = dem.materials().index_of(sh.material);
         dipper_wall_ = coupled_->body(coupled_->couple(parts.dipper, dipper_.body.surface, steel, "dipper")).wall;
         door_wall_ = coupled_->body(coupled_->couple(parts.door, dipper_.door.surface, steel, "door")).wall;
+        for (const std::uint32_t plate : dipper_.body.triangle_plate) {
+            const std::size_t region = dipper_region(plate);
+            lip_triangle_.push_back(region == 1 || region == 4 ? 1 : 0);
+        }
+        dipper_locator_ = std::make_unique<meshes::TriangleLocator>(dipper_.body.surface);
     }
+}
+
+std::size_t RigidScene::dipper_region(std::uint32_t plate) const
+{
+    // the plates in make_dipper's order: bottom, lip, two sides, top, the teeth, then the wear bars
+    if (plate <= 1) return plate;
+    if (plate <= 3) return 2;
+    if (plate == 4) return 3;
+    return plate < 5 + static_cast<std::size_t>(dipper_.parameters.tooth_count) ? 4 : 5;
 }
 
 RigidScene::~RigidScene() = default;
@@ -327,6 +341,8 @@ void RigidScene::write_state(StateWriter& out) const
     out.value(dig_force_peak_);
     out.value(interface_force_sum_);
     out.value(interface_force_peak_);
+    out.value(without_lip_sum_);
+    out.value(without_lip_peak_);
     out.value(dig_samples_);
 }
 
@@ -346,6 +362,8 @@ void RigidScene::read_state(StateReader& in)
     dig_force_peak_ = in.value<double>();
     interface_force_sum_ = in.value<double>();
     interface_force_peak_ = in.value<double>();
+    without_lip_sum_ = in.value<double>();
+    without_lip_peak_ = in.value<double>();
     dig_samples_ = in.value<std::uint64_t>();
 }
 
@@ -393,6 +411,24 @@ Vec3 RigidScene::interface_force_N() const
            rigid_->contact_force_N(door_body_);
 }
 
+Vec3 RigidScene::lip_force_N() const
+{
+    if (!has_shovel()) return {};
+    Vec3 f;
+    for (const ContactRecord& r : dem_->last_contact_records())
+        if (r.surface_id == dipper_wall_ && r.triangle_id >= 0 && lip_triangle_[static_cast<std::size_t>(r.triangle_id)])
+            f -= r.normal_world * r.normal_force_N + r.tangential_force_N;  // the records hold the force on the sphere
+    Mat3 rotation;
+    Vec3 origin;
+    rigid_->dipper_pose(rotation, origin);
+    const Mat3 back = rotation.transposed();
+    for (const rigid::RigidWorld::PointForce& p : rigid_->contact_point_forces(dipper_body_)) {
+        const std::int32_t t = dipper_locator_->nearest(back * (p.point_m - origin)).triangle;
+        if (t >= 0 && lip_triangle_[static_cast<std::size_t>(t)]) f += p.force_N;
+    }
+    return f;
+}
+
 void RigidScene::track_passes()
 {
     if (!has_shovel()) return;
@@ -411,9 +447,12 @@ void RigidScene::track_passes()
     if (!door_open_ && digging) {
         dig_force_sum_ += r.dig_force_N;
         dig_force_peak_ = std::max(dig_force_peak_, r.dig_force_N);
-        const double interface = norm(interface_force_N());
+        const Vec3 total = interface_force_N();
+        const double interface = norm(total), without_lip = norm(total - lip_force_N());
         interface_force_sum_ += interface;
         interface_force_peak_ = std::max(interface_force_peak_, interface);
+        without_lip_sum_ += without_lip;
+        without_lip_peak_ = std::max(without_lip_peak_, without_lip);
         if (dig_samples_++ == 0) dig_start_s_ = t;
         dig_end_s_ = t;
     }
@@ -431,6 +470,8 @@ void RigidScene::track_passes()
         pass.peak_dig_force_N = dig_force_peak_;
         pass.mean_interface_force_N = dig_samples_ > 0 ? interface_force_sum_ / static_cast<double>(dig_samples_) : 0.0;
         pass.peak_interface_force_N = interface_force_peak_;
+        pass.mean_interface_force_without_lip_N = dig_samples_ > 0 ? without_lip_sum_ / static_cast<double>(dig_samples_) : 0.0;
+        pass.peak_interface_force_without_lip_N = without_lip_peak_;
         passes_.push_back(pass);
     }
     if (door_open_ && r.door_deg < 1.0) {
@@ -438,6 +479,7 @@ void RigidScene::track_passes()
         pass_start_s_ = t;
         dig_force_sum_ = dig_force_peak_ = 0.0;
         interface_force_sum_ = interface_force_peak_ = 0.0;
+        without_lip_sum_ = without_lip_peak_ = 0.0;
         dig_samples_ = 0;
         dig_start_s_ = dig_end_s_ = -1.0;
     }
@@ -446,17 +488,9 @@ void RigidScene::track_passes()
 std::vector<std::pair<std::string, double>> RigidScene::wear_by_region(const SceneWear& w) const
 {
     if (w.spec.part != "dipper") return {};
-    // the plates in make_dipper's order: bottom, lip, two sides, top, the teeth, then the wear bars
-    const std::size_t teeth = static_cast<std::size_t>(dipper_.parameters.tooth_count);
-    const auto region = [&](std::uint32_t plate) -> std::size_t {
-        if (plate <= 1) return plate;
-        if (plate <= 3) return 2;
-        if (plate == 4) return 3;
-        return plate < 5 + teeth ? 4 : 5;
-    };
     std::vector<std::pair<std::string, double>> v{{"bottom", 0.0}, {"lip", 0.0}, {"sides", 0.0}, {"top", 0.0}, {"teeth", 0.0}, {"bars", 0.0}};
     const std::vector<double>& volume = w.surface->triangle_volume_m3();
-    for (std::size_t t = 0; t < volume.size(); ++t) v[region(dipper_.body.triangle_plate[t])].second += volume[t];
+    for (std::size_t t = 0; t < volume.size(); ++t) v[dipper_region(dipper_.body.triangle_plate[t])].second += volume[t];
     return v;
 }
 

@@ -4,6 +4,7 @@
 
 #include "coupling/coupled_world.h"
 #include "meshes/machine_geometry.h"
+#include "meshes/triangle_locator.h"
 #include "rigid/motion_curves.h"
 #include "rigid/rigid_world.h"
 #include "scenario/scenario.h"
@@ -33,6 +34,9 @@ struct PassRecord {
     /// and rocks): the "resultant interface force" of thesis Paper B Fig. 19, which compares the wear bars.
     double mean_interface_force_N = 0.0;
     double peak_interface_force_N = 0.0;
+    /// The same without the lip and its teeth: what Fig. 19 plots ("acting on the bucket (excluding lip)").
+    double mean_interface_force_without_lip_N = 0.0;
+    double peak_interface_force_without_lip_N = 0.0;
 };
 
 /// What the dipper holds now.
@@ -90,6 +94,9 @@ public:
     const rigid::ShovelReading& reading() const;
     /// Resultant force of the spheres and rocks on dipper and door in the last step, N (0 without a shovel).
     Vec3 interface_force_N() const;
+    /// The part of it on the dipper's lip and teeth, N: the spheres' contacts on those triangles and the rocks'
+    /// contact points nearest to them.
+    Vec3 lip_force_N() const;
     BucketContents bucket() const;
     const std::vector<PassRecord>& passes() const { return passes_; }
     /// Mass carried out of the dipper so far: the sum of the passes' masses, t.
@@ -123,6 +130,8 @@ public:
 
 private:
     void track_passes();
+    /// 0 bottom, 1 lip, 2 sides, 3 top, 4 teeth, 5 wear bars: the dipper's regions by plate.
+    std::size_t dipper_region(std::uint32_t plate) const;
 
     const dem::World* dem_ = nullptr;
     std::unique_ptr<rigid::RigidWorld> rigid_;
@@ -146,6 +155,9 @@ private:
     bool door_open_ = false;
     double pass_start_s_ = 0.0, dig_start_s_ = -1.0, dig_end_s_ = -1.0, dig_force_sum_ = 0.0, dig_force_peak_ = 0.0;
     double interface_force_sum_ = 0.0, interface_force_peak_ = 0.0;
+    double without_lip_sum_ = 0.0, without_lip_peak_ = 0.0;
+    std::vector<std::uint8_t> lip_triangle_;  ///< per triangle of dipper_.body.surface: on the lip or a tooth
+    std::unique_ptr<meshes::TriangleLocator> dipper_locator_;  ///< finds a rock's contact point's triangle
     std::uint64_t dig_samples_ = 0;
     // a built-in cycle's digs: [start + k period, start + k period + dig]; period 0: a motion file
     double cycle_start_s_ = 0.0, cycle_period_s_ = 0.0, cycle_dig_s_ = 0.0;

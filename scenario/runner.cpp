@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "dipper-checkpoint 3";
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 4";
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int signal) { g_signal = signal; }
@@ -626,7 +626,9 @@ private:
                     << ", \"mean_dig_force_N\": " << json_number(p.mean_dig_force_N)
                     << ", \"peak_dig_force_N\": " << json_number(p.peak_dig_force_N)
                     << ", \"mean_interface_force_N\": " << json_number(p.mean_interface_force_N)
-                    << ", \"peak_interface_force_N\": " << json_number(p.peak_interface_force_N) << "}";
+                    << ", \"peak_interface_force_N\": " << json_number(p.peak_interface_force_N)
+                    << ", \"mean_interface_force_without_lip_N\": " << json_number(p.mean_interface_force_without_lip_N)
+                    << ", \"peak_interface_force_without_lip_N\": " << json_number(p.peak_interface_force_without_lip_N) << "}";
             }
             out << (r.passes().empty() ? "]" : "\n  ]");
         }

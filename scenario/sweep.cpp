@@ -277,7 +277,8 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
     for (const RegionProbe& r : first.regions) out << ',' << r.name << "_mass_kg";
     if (first.repose) out << ",repose_angle_deg";
     for (std::size_t k = 1; k <= passes; ++k)
-        out << ",pass" << k << "_mass_kg,pass" << k << "_fill_factor,pass" << k << "_mean_dig_force_N,pass" << k << "_mean_interface_force_N";
+        out << ",pass" << k << "_mass_kg,pass" << k << "_fill_factor,pass" << k << "_mean_dig_force_N,pass" << k << "_mean_interface_force_N,pass"
+            << k << "_mean_interface_force_without_lip_N";
     if (first.shovel) out << ",tonnage_t";
     for (const WearSpec& w : first.wear) {
         out << ",wear_" << w.part << "_m3";
@@ -296,7 +297,7 @@ void write_sweep_table(const Sweep& sweep, const std::string& out_dir)
         if (first.repose) out << ',' << json_field(s, "repose_angle_deg");
         const std::vector<std::string> p = pass_objects(s);
         for (std::size_t k = 0; k < passes; ++k)
-            for (const char* key : {"mass_kg", "fill_factor", "mean_dig_force_N", "mean_interface_force_N"})
+            for (const char* key : {"mass_kg", "fill_factor", "mean_dig_force_N", "mean_interface_force_N", "mean_interface_force_without_lip_N"})
                 out << ',' << (k < p.size() ? json_field(p[k], key) : "");
         if (first.shovel) out << ',' << json_field(s, "tonnage_t");
         const std::string wear = s.substr(std::min(s.size(), s.find("\"wear\": {")));

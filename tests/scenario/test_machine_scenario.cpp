@@ -522,6 +522,53 @@ TEST_CASE("the interface force of spheres and rocks held in the dipper is their 
     fs::remove_all(dir);
 }
 
+TEST_CASE("the force on the lip and its teeth is told from the rest of the dipper's, for a sphere and for a rock",
+          "[scenario][shovel]")
+{
+    // The held pose with the fill moved far from the shovel, and one body pressed 1-2 mm into the dipper's
+    // working face (z = 0 in its frame): in the middle of the lip (x 3.6-4.0 m) or of the bottom (x < 3.6 m).
+    // After one coupling step that body's contact is all the interface force there is: all of it on the lip,
+    // or none. The rock's contacts are Bullet's (their points located on the dipper's mesh), the sphere's the DEM's
+    const std::string dir = (fs::temp_directory_path() / "dipper_lip_force").string();
+    const std::string body = GENERATE(as<std::string>{}, "sphere", "rock");
+    const double x = GENERATE(3.8, 2.0);
+    std::string text = held_in_dipper(dir, 1.0, 0.0, "sizes: [{radius_m: 0.15, mass_fraction: 1}]");
+    text = std::regex_replace(text, std::regex("box: \\{min_m: \\[[^]]*\\], max_m: \\[[^]]*\\]\\}"),
+                              "box: {min_m: [-30, -1, 0], max_m: [-28, 1, 2]}");
+    text = std::regex_replace(text, std::regex("mass_kg: 2500"), "mass_kg: 200");
+    const Scenario s = parse_scenario(text, "lip.yaml", dir);
+    auto dem = build_world(s);
+    RigidScene scene(s, *dem);
+    build_particles(s, *dem);
+    Mat3 r;
+    Vec3 o;
+    scene.rigid().dipper_pose(r, o);
+    if (body == "sphere") {
+        dem::ParticleSpawn p;
+        p.radius_m = 0.15;
+        p.position_m = o + r * Vec3{x, 0.0, p.radius_m - 0.002};
+        p.material = dem->materials().index_of("ore");
+        dem->add_particle(p);
+    } else {
+        std::vector<Vec3> corners;  // a 0.3 x 0.2 x 0.1 m block, turned with the dipper, its lowest face 1 mm in
+        for (double a : {-0.15, 0.15})
+            for (double b : {-0.1, 0.1})
+                for (double c : {-0.05, 0.05}) corners.push_back({a, b, c});
+        const rigid::ConvexPolyhedron block = rigid::ConvexPolyhedron::hull_of(corners, "block").in_principal_frame();
+        double lowest = 0.0;
+        for (const Vec3& v : block.vertices_m()) lowest = std::min(lowest, v.z);
+        scene.coupled().add_rock(block, 2700.0, scene.rigid().material_index("rock"), dem->materials().index_of("rock"),
+                                 o + r * Vec3{x, 0.0, -lowest - 0.001}, r);
+    }
+    scene.step();
+    const Vec3 total = scene.interface_force_N(), lip = scene.lip_force_N();
+    UNSCOPED_INFO(body << " at x = " << x << " m: interface force " << norm(total) << " N, on the lip " << norm(lip) << " N");
+    REQUIRE(norm(total) > 1.0);  // it touches: more than a newton
+    if (x > 3.6) CHECK(norm(lip - total) < 1e-9 * norm(total));  // the same sums, to round-off
+    else CHECK(norm(lip) == 0.0);
+    fs::remove_all(dir);
+}
+
 TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a diagnosis", "[scenario][shovel]")
 {
     const Scenario s = parse_scenario(base("shovel: {element_size_m: 0.3}\n"), "case.yaml", ".");
@@ -571,7 +618,7 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and fo
             << "\"lip\": 0.125, \"sides\": 0, \"top\": 0, \"teeth\": 0, \"bars\": 0}}}\n}\n";
     };
     summary(dir / "variant_000" / "summary.json",
-            "\n    {\"pass\": 1, \"mass_kg\": 80000, \"fill_factor\": 1.0, \"mean_dig_force_N\": 4200000, \"mean_interface_force_N\": 2100000},"
+            "\n    {\"pass\": 1, \"mass_kg\": 80000, \"fill_factor\": 1.0, \"mean_dig_force_N\": 4200000, \"mean_interface_force_N\": 2100000, \"mean_interface_force_without_lip_N\": 1900000},"
             "\n    {\"pass\": 2, \"mass_kg\": 70000, \"fill_factor\": 0.875, \"mean_dig_force_N\": 3900000}",
             0.5);
     summary(dir / "variant_001" / "summary.json", "\n    {\"pass\": 1, \"mass_kg\": 85000, \"fill_factor\": 1.0625, \"mean_dig_force_N\": 4300000}",
@@ -584,11 +631,12 @@ TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and fo
     std::getline(in, first);
     std::getline(in, second);
     CHECK_THAT(header, Catch::EndsWith("repose_angle_deg,pass1_mass_kg,pass1_fill_factor,pass1_mean_dig_force_N,pass1_mean_interface_force_N,"
-                                       "pass2_mass_kg,pass2_fill_factor,pass2_mean_dig_force_N,pass2_mean_interface_force_N,"
+                                       "pass1_mean_interface_force_without_lip_N,pass2_mass_kg,pass2_fill_factor,pass2_mean_dig_force_N,"
+                                       "pass2_mean_interface_force_N,pass2_mean_interface_force_without_lip_N,"
                                        "tonnage_t,wear_dipper_m3,wear_dipper_bottom_m3,wear_dipper_lip_m3,wear_dipper_bars_m3"));
     // a field a summary lacks (an older run's) stays empty
-    CHECK_THAT(first, Catch::StartsWith("0,\"59.8\",completed,") && Catch::EndsWith(",30.5,80000,1.0,4200000,2100000,70000,0.875,3900000,,150,0.5,0.25,0.125,0"));
-    CHECK_THAT(second, Catch::StartsWith("1,\"63.8\",completed,") && Catch::EndsWith(",30.75,85000,1.0625,4300000,,,,,,150,0.75,0.25,0.125,0"));
+    CHECK_THAT(first, Catch::StartsWith("0,\"59.8\",completed,") && Catch::EndsWith(",30.5,80000,1.0,4200000,2100000,1900000,70000,0.875,3900000,,,150,0.5,0.25,0.125,0"));
+    CHECK_THAT(second, Catch::StartsWith("1,\"63.8\",completed,") && Catch::EndsWith(",30.75,85000,1.0625,4300000,,,,,,,,150,0.75,0.25,0.125,0"));
     fs::remove_all(dir);
 }
 
