@@ -169,7 +169,8 @@ try:
                    "force [MN]",
                    [(label, [v / 1e6 for v in series[c]]) for label, c in
                     (("dig force (eq. 11)", "dig_force_N"), ("hoist", "hoist_force_N"), ("crowd", "crowd_force_N"),
-                     ("interface force on dipper and door", "interface_force_N")) if c in series])
+                     ("interface force on dipper and door", "interface_force_N"),
+                     ("the same without the lip (thesis Fig. 19)", "interface_force_without_lip_N")) if c in series])
             fig, ax = plt.subplots(figsize=(7, 3.6), dpi=110)
             ax.plot(t, [v / 1000.0 for v in series["bucket_mass_kg"]], linewidth=1.2, color="tab:blue")
             ax.set_xlabel("time [s]")

@@ -311,7 +311,7 @@ private:
         if (rigid_) {
             csv_ << ",rocks,rock_kinetic_energy_J,rock_contacts";
             if (rigid_->has_shovel())
-                csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,interface_force_N,swing_deg,door_deg,"
+                csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,interface_force_N,interface_force_without_lip_N,swing_deg,door_deg,"
                         "handle_angle_deg,crowd_extension_m,tooth_tip_x_m,tooth_tip_y_m,tooth_tip_z_m";
             for (const SceneWear& w : rigid_->wear()) csv_ << ",wear_" << w.spec.part << "_m3";
         }
@@ -368,7 +368,8 @@ private:
                 const BucketContents b = rigid_->bucket();
                 const rigid::ShovelReading& r = rigid_->reading();
                 csv_ << ',' << b.mass_kg << ',' << b.fill_factor << ',' << r.crowd_force_filtered_N << ',' << r.hoist_force_filtered_N << ','
-                     << r.dig_force_filtered_N << ',' << norm(rigid_->interface_force_N()) << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
+                     << r.dig_force_filtered_N << ',' << norm(rigid_->interface_force_N()) << ','
+                     << norm(rigid_->interface_force_N() - rigid_->lip_force_N()) << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
                      << r.crowd_extension_m << ',' << r.tooth_tip_m.x << ',' << r.tooth_tip_m.y << ',' << r.tooth_tip_m.z;
             }
             for (const SceneWear& sw : rigid_->wear()) csv_ << ',' << sw.surface->total_volume_m3();
