@@ -29,6 +29,14 @@ bool pair_material_callback(btManifoldPoint& cp, const btCollisionObjectWrapper*
     return true;
 }
 
+/// The force of a contact point on body A over a step of dt: normal and friction impulses / dt (B gets its
+/// opposite).
+Vec3 point_force_on_a(const btManifoldPoint& p, double dt)
+{
+    return (from_bt(p.m_normalWorldOnB) * p.m_appliedImpulse + from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
+            from_bt(p.m_lateralFrictionDir2) * p.m_appliedImpulseLateral2) * (1.0 / dt);
+}
+
 }  // namespace
 
 RigidWorld::RigidWorld(RigidSettings settings)
@@ -325,9 +333,7 @@ void RigidWorld::step()
         const btPersistentManifold* m = d.getManifoldByIndexInternal(q);
         const int a = m->getBody0()->getUserIndex2(), b = m->getBody1()->getUserIndex2();
         for (int k = 0; k < m->getNumContacts(); ++k) {
-            const btManifoldPoint& p = m->getContactPoint(k);
-            const Vec3 on_a = (from_bt(p.m_normalWorldOnB) * p.m_appliedImpulse + from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
-                               from_bt(p.m_lateralFrictionDir2) * p.m_appliedImpulseLateral2) * (1.0 / dt);
+            const Vec3 on_a = point_force_on_a(m->getContactPoint(k), dt);
             impl_->contact_force[static_cast<std::size_t>(a)] += on_a;
             impl_->contact_force[static_cast<std::size_t>(b)] -= on_a;
         }
@@ -460,9 +466,7 @@ std::vector<RigidWorld::PointForce> RigidWorld::contact_point_forces(BodyId id) 
         if (!is_a && !is_b) continue;
         for (int k = 0; k < m->getNumContacts(); ++k) {
             const btManifoldPoint& p = m->getContactPoint(k);
-            // the same force as contact_force_N's: on A, its opposite on B
-            const Vec3 on_a = (from_bt(p.m_normalWorldOnB) * p.m_appliedImpulse + from_bt(p.m_lateralFrictionDir1) * p.m_appliedImpulseLateral1 +
-                               from_bt(p.m_lateralFrictionDir2) * p.m_appliedImpulseLateral2) * (1.0 / dt);
+            const Vec3 on_a = point_force_on_a(p, dt);  // as contact_force_N sums it
             if (is_a) out.push_back({from_bt(p.getPositionWorldOnA()), on_a});
             if (is_b) out.push_back({from_bt(p.getPositionWorldOnB()), -on_a});
         }
