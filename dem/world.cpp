@@ -377,10 +377,11 @@ void World::finish_step(double dt_s)
     if (consumer_) consumer_(last_contact_records(), time_s_, dt_s);
 
     // the first wall contact (in list order) past the overlap limit, found by the wall phase
-    std::size_t first = kNoContact;
+    std::size_t first = kNoContact, first_convex = kNoContact;
     for (std::size_t f : thread_first_deep_contact_) first = std::min(first, f);
-    if (first != kNoContact) {
-        const WallContact& c = wall_contacts_[first];
+    for (std::size_t f : thread_first_deep_convex_) first_convex = std::min(first_convex, f);
+    if (first != kNoContact || first_convex != kNoContact) {
+        const WallContact& c = first != kNoContact ? wall_contacts_[first] : convex_contacts_[first_convex];
         const double ratio = c.overlap_m / particles_.radius_m[c.particle];
         const Vec3 p = particles_.position_m[c.particle];
         const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
@@ -406,10 +407,15 @@ void World::finish_step(double dt_s)
 const std::vector<ContactRecord>& World::last_contact_records() const
 {
     if (!records_stale_) return records_;
-    records_.resize(wall_contacts_.size());
+    // the contacts of planes and open meshes in particle order, then those of convex bodies, body by body
+    std::vector<const WallContact*> contacts(wall_contacts_.size());
+    for (std::size_t k = 0; k < wall_contacts_.size(); ++k) contacts[k] = &wall_contacts_[k];
+    for (std::size_t k = 0; k < convex_pairs_.size(); ++k)
+        if (convex_touching_[k]) contacts.push_back(&convex_contacts_[k]);
+    records_.resize(contacts.size());
 #pragma omp parallel for schedule(static) num_threads(threads_)
-    for (std::size_t k = 0; k < wall_contacts_.size(); ++k) {
-        const WallContact& c = wall_contacts_[k];
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        const WallContact& c = *contacts[k];
         ContactRecord& r = records_[k];
         r.point_world = c.point;
         r.normal_world = c.normal;
@@ -572,19 +578,20 @@ void World::rebuild()
         }
     }
 
-    // wall contacts keep their history: renumber and re-sort by particle
+    // wall contacts keep their history (those on convex bodies too): renumbered and re-sorted by particle
+    for (std::size_t k = 0; k < convex_pairs_.size(); ++k)
+        if (convex_touching_[k]) wall_contacts_.push_back(convex_contacts_[k]);
     for (WallContact& c : wall_contacts_) c.particle = c.particle < n ? old_to_new[c.particle] : std::uint32_t(n);
     wall_contacts_.erase(std::remove_if(wall_contacts_.begin(), wall_contacts_.end(),
                                         [n](const WallContact& c) { return c.particle >= n; }),
                          wall_contacts_.end());
     std::stable_sort(wall_contacts_.begin(), wall_contacts_.end(),
                      [](const WallContact& a, const WallContact& b) { return a.particle < b.particle; });
-    wall_contact_start_.assign(n + 1, 0);
-    for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
-    std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
 
-    // planes and triangles near each particle
+    // planes and triangles near each particle, and the pairs of spheres and convex bodies, which take the
+    // history of their contacts
     build_wall_candidates(lo, cell, dims, cell_start);
+    split_convex_contacts();
 
     reference_position_m_ = particles_.position_m;
     reference_mesh_rotation_.resize(meshes_.size());
@@ -604,15 +611,21 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     candidates_.clear();
     candidate_triangles_.clear();
     candidate_ids_.clear();
-    if (walls_.empty() || n == 0) return;
+    if (walls_.empty() || n == 0) {
+        split_candidates();
+        return;
+    }
     double r_max = 0.0;
     for (double r : particles_.radius_m) r_max = std::max(r_max, r);
     const double reach = r_max + skin_m_;
 
     // triangles into every cell their inflated bounding box overlaps
     const std::size_t cell_count = cell_start.size() - 1;
+    // the large lists live in scratch_ from rebuild to rebuild: fresh ones of some megabytes would be mapped
+    // and faulted in page by page each time (measured: a third of the rebuild)
     std::vector<std::uint32_t> bucket_count(cell_count + 1, 0);
-    std::vector<std::pair<std::uint32_t, MeshCandidate>> entries;
+    auto& entries = scratch_.entries;
+    entries.clear();
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
         const auto& verts = meshes_[m].vertices_world_m();
         const auto& tris = meshes_[m].mesh().triangles();
@@ -639,21 +652,24 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     }
     for (const auto& e : entries) ++bucket_count[e.first + 1];
     std::partial_sum(bucket_count.begin(), bucket_count.end(), bucket_count.begin());
-    std::vector<MeshCandidate> bucket(entries.size());
+    auto& bucket = scratch_.bucket;
+    bucket.resize(entries.size());
     {
         std::vector<std::uint32_t> fill(bucket_count.begin(), bucket_count.end() - 1);
         for (const auto& e : entries) bucket[fill[e.first]++] = e.second;
     }
 
     // each particle keeps the planes, then the triangles of its own cell, that lie within r + skin
-    std::vector<std::vector<MeshCandidate>> per_thread(static_cast<std::size_t>(threads_));
+    auto& per_thread = scratch_.per_thread;
+    per_thread.resize(static_cast<std::size_t>(threads_));
     std::vector<std::uint32_t> counts(n, 0);
 #pragma omp parallel num_threads(threads_)
     {
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         thread_block(n, t, threads_, begin, end);
-        std::vector<MeshCandidate> out;  // a local, moved in at the end (the headers share a cache line)
+        std::vector<MeshCandidate> out = std::move(per_thread[static_cast<std::size_t>(t)]);  // a local, moved back at
+        out.clear();                                                                          // the end (the headers share a cache line)
         for (std::size_t i = begin; i < end; ++i) {
             const Vec3 p = particles_.position_m[i];
             int c[3];
@@ -690,19 +706,130 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     }
     for (std::size_t i = 0; i < n; ++i) candidate_start_[i + 1] = candidate_start_[i] + counts[i];
     for (const auto& v : per_thread) candidates_.insert(candidates_.end(), v.begin(), v.end());
-    copy_candidate_triangles();
+    split_candidates();
 }
 
-void World::copy_candidate_triangles()
+void World::split_candidates()
 {
-    // each candidate's triangle beside it: the search streams through them instead of visiting the meshes
-    candidate_triangles_.resize(candidates_.size());
-    candidate_ids_.resize(candidates_.size());
-    for (std::size_t k = 0; k < candidates_.size(); ++k)
-        if (candidates_[k].triangle != kPlaneCandidate) {
-            candidate_triangles_[k] = meshes_[candidates_[k].mesh].packed_body(candidates_[k].triangle);
-            candidate_ids_[k] = meshes_[candidates_[k].mesh].triangle_ids(candidates_[k].triangle);
+    // Planes and open meshes stay with their particle; a convex body's triangles become one pair of the sphere
+    // and that body, with the faces copied beside it (candidates_ lists a particle's triangles mesh by mesh, so a
+    // body's faces are one run). Each thread takes the pairs of the particles whose forces it gathers
+    // (thread_block, as the gather's static schedule), body by body: a counting sort on (thread, body), stable,
+    // so by particle within a body. Two passes over the candidates, no copy of them.
+    const std::size_t n = candidate_start_.empty() ? 0 : candidate_start_.size() - 1;
+    const std::size_t bodies = meshes_.size();
+    std::vector<std::uint32_t> key_start(static_cast<std::size_t>(threads_) * bodies + 1, 0);
+    auto each_convex_run = [&](auto&& visit) {
+        int t = 0;
+        std::size_t block_begin = 0, block_end = 0;
+        thread_block(n, t, threads_, block_begin, block_end);
+        for (std::size_t i = 0; i < n; ++i) {
+            while (i >= block_end && t + 1 < threads_) thread_block(n, ++t, threads_, block_begin, block_end);
+            for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1];) {
+                const MeshCandidate mc = candidates_[k];
+                if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) {
+                    ++k;
+                    continue;
+                }
+                std::uint32_t run_end = k + 1;
+                while (run_end < candidate_start_[i + 1] && candidates_[run_end].mesh == mc.mesh) ++run_end;
+                visit(static_cast<std::size_t>(t) * bodies + mc.mesh, ConvexPair{mc.mesh, static_cast<std::uint32_t>(i), k, run_end});
+                k = run_end;
+            }
         }
+    };
+    each_convex_run([&](std::size_t key, const ConvexPair&) { ++key_start[key + 1]; });
+    std::partial_sum(key_start.begin(), key_start.end(), key_start.begin());
+    convex_thread_start_.resize(static_cast<std::size_t>(threads_) + 1);
+    for (int t = 0; t <= threads_; ++t) convex_thread_start_[static_cast<std::size_t>(t)] = key_start[static_cast<std::size_t>(t) * bodies];
+    convex_pairs_.resize(key_start.back());
+    each_convex_run([&](std::size_t key, const ConvexPair& p) { convex_pairs_[key_start[key]++] = p; });
+
+    // the faces beside the pairs, in pair order
+    convex_faces_.clear();
+    convex_face_triangle_.clear();
+    for (ConvexPair& p : convex_pairs_) {
+        const auto at = static_cast<std::uint32_t>(convex_faces_.size());
+        for (std::uint32_t k = p.face_begin; k < p.face_end; ++k) {
+            convex_faces_.push_back(meshes_[p.mesh].packed_body(candidates_[k].triangle));
+            convex_face_triangle_.push_back(static_cast<std::int32_t>(candidates_[k].triangle));
+        }
+        p.face_end = at + (p.face_end - p.face_begin);
+        p.face_begin = at;
+    }
+    // a pair's contact is read only while it touches, so the contacts need no clearing
+    convex_contacts_.resize(convex_pairs_.size());
+    convex_touching_.assign(convex_pairs_.size(), 0);
+    convex_push_.assign(convex_pairs_.size(), Push{});
+    convex_contact_count_ = 0;
+    convex_pair_start_.assign(n + 1, 0);
+    for (const ConvexPair& p : convex_pairs_) ++convex_pair_start_[p.particle + 1];
+    std::partial_sum(convex_pair_start_.begin(), convex_pair_start_.end(), convex_pair_start_.begin());
+    convex_pair_index_.resize(convex_pairs_.size());
+    for (std::size_t k = 0; k < convex_pairs_.size(); ++k) convex_pair_index_[convex_pair_start_[convex_pairs_[k].particle]++] = static_cast<std::uint32_t>(k);
+    for (std::size_t i = n; i > 0; --i) convex_pair_start_[i] = convex_pair_start_[i - 1];  // the fill moved each start to the next
+    if (n > 0) convex_pair_start_[0] = 0;
+
+    // the other candidates, with their triangles beside them
+    wall_candidate_start_.assign(n + 1, 0);
+    wall_candidates_.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1]; ++k) {
+            const MeshCandidate mc = candidates_[k];
+            if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) wall_candidates_.push_back(mc);
+        }
+        wall_candidate_start_[i + 1] = static_cast<std::uint32_t>(wall_candidates_.size());
+    }
+    candidate_triangles_.resize(wall_candidates_.size());
+    candidate_ids_.resize(wall_candidates_.size());
+    for (std::size_t k = 0; k < wall_candidates_.size(); ++k)
+        if (wall_candidates_[k].triangle != kPlaneCandidate) {
+            candidate_triangles_[k] = meshes_[wall_candidates_[k].mesh].packed_body(wall_candidates_[k].triangle);
+            candidate_ids_[k] = meshes_[wall_candidates_[k].mesh].triangle_ids(wall_candidates_[k].triangle);
+        }
+}
+
+void World::split_convex_contacts()
+{
+    // a contact on a convex body goes to its pair (if the sphere is still within reach), the others stay
+    const std::size_t n = particles_.size();
+    std::size_t kept = 0;
+    for (std::size_t q = 0; q < wall_contacts_.size(); ++q) {
+        const WallContact& c = wall_contacts_[q];
+        const WallRef& ref = walls_[static_cast<std::size_t>(c.wall)];
+        if (!ref.is_mesh || !meshes_[static_cast<std::size_t>(ref.index)].convex()) {
+            wall_contacts_[kept++] = c;
+            continue;
+        }
+        const auto mesh = static_cast<std::uint32_t>(ref.index);
+        for (std::uint32_t slot = convex_pair_start_[c.particle]; slot < convex_pair_start_[c.particle + 1]; ++slot) {
+            const std::uint32_t k = convex_pair_index_[slot];
+            if (convex_pairs_[k].mesh != mesh) continue;
+            if (!convex_touching_[k]) {  // one contact per body (a second one only from an older rule)
+                convex_contacts_[k] = c;
+                convex_touching_[k] = 1;
+            }
+            break;
+        }  // no pair: the sphere has gone out of reach, and the contact has ended
+    }
+    wall_contacts_.resize(kept);
+    wall_contact_start_.assign(n + 1, 0);
+    for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
+    std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
+}
+
+std::vector<World::WallContact> World::merged_wall_contacts() const
+{
+    const std::size_t n = convex_pair_start_.empty() ? 0 : convex_pair_start_.size() - 1;
+    if (convex_pairs_.empty() || wall_contact_start_.size() != n + 1) return wall_contacts_;
+    std::vector<WallContact> all;
+    all.reserve(wall_contacts_.size() + convex_contact_count_);
+    for (std::size_t i = 0; i < n; ++i) {
+        all.insert(all.end(), wall_contacts_.begin() + wall_contact_start_[i], wall_contacts_.begin() + wall_contact_start_[i + 1]);
+        for (std::uint32_t k = convex_pair_start_[i]; k < convex_pair_start_[i + 1]; ++k)
+            if (convex_touching_[convex_pair_index_[k]]) all.push_back(convex_contacts_[convex_pair_index_[k]]);
+    }
+    return all;
 }
 
 // ---- forces --------------------------------------------------------------------------------------
@@ -843,84 +970,30 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
     hits.clear();
     auto push_hit = [&](const WallHit& h) { hits.push_back(h); };
 
-    const std::uint32_t first = candidate_start_[i], last = candidate_start_[i + 1];
-    if (first == last) return;  // most particles: no wall within reach since the last rebuild
+    const std::uint32_t first = wall_candidate_start_[i], last = wall_candidate_start_[i + 1];
+    if (first == last) return;  // most particles: no plane or open mesh within reach since the last rebuild
 
     // analytic planes (listed first)
     std::uint32_t k = first;
-    for (; k < last && candidates_[k].triangle == kPlaneCandidate; ++k) {
-        const std::size_t q = candidates_[k].mesh;
+    for (; k < last && wall_candidates_[k].triangle == kPlaneCandidate; ++k) {
+        const std::size_t q = wall_candidates_[k].mesh;
         const PlaneWall& pl = planes_[q];
         const double dist = dot(x, pl.normal) - plane_offset_m_[q];
         if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, kPlaneCandidate, x - pl.normal * dist, pl.normal, r - dist, true});
     }
 
-    // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point
+    // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point; each
+    // mesh's triangles are tested in its body frame, with the sphere's centre moved there once per mesh
     const int first_mesh_hit = static_cast<int>(hits.size());
-    auto push_triangle_hit = [&](std::uint32_t q, const MeshWall& mw, const Vec3& xb, const meshes::ClosestPoint& cp) {
-        const MeshCandidate mc = candidates_[q];
-        const double dist = std::sqrt(cp.distance_squared);
-        const Vec3 point = mw.to_world(cp.point);
-        const Vec3 normal = mw.rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : candidate_triangles_[q].normal);
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, cp.local_index, q, point, normal,
-                  r - dist, true});
-    };
-    // each mesh's triangles are tested in its body frame, with the sphere's centre moved there once per mesh
     std::uint32_t body_mesh = kPlaneCandidate;
+    const MeshWall* mw = nullptr;
     Vec3 xb;
     for (; k < last; ++k) {
-        const MeshCandidate mc = candidates_[k];
-        const MeshWall& mw = meshes_[mc.mesh];
+        const MeshCandidate mc = wall_candidates_[k];
         if (mc.mesh != body_mesh) {
             body_mesh = mc.mesh;
-            xb = mw.to_body(x);
-            if (mw.convex()) {
-                // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in
-                // front of one candidate face touches none of them. A centre in front of some face lies outside,
-                // and the hull's closest point then lies on a face it is in front of (the direction to it is in
-                // the normal cone there); a face whose interior holds its closest point holds the hull's.
-                // So one contact per body, from the faces it faces, without the per-triangle search below.
-                std::uint32_t end = k + 1;
-                while (end < last && candidates_[end].mesh == mc.mesh) ++end;
-                const double clear = r + mw.convex_slack_m();
-                double farthest = -std::numeric_limits<double>::infinity();
-                std::uint32_t farthest_q = k;
-                bool separated = false;
-                for (std::uint32_t q = k; q < end && !separated; ++q) {
-                    const double d = dot(xb - candidate_triangles_[q].a, candidate_triangles_[q].normal);
-                    separated = d >= clear;
-                    if (d > farthest) {
-                        farthest = d;
-                        farthest_q = q;
-                    }
-                }
-                if (!separated && farthest > 0.0) {
-                    // the face the centre is farthest in front of comes first: when the closest point of a
-                    // sphere on a face lies inside it, this is that face, and one query settles the body
-                    const PackedTriangle& ft = candidate_triangles_[farthest_q];
-                    meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
-                    std::uint32_t best = farthest_q;
-                    if (best_cp.feature != meshes::Feature::Face) {
-                        for (std::uint32_t q = k; q < end; ++q) {
-                            const PackedTriangle& pt = candidate_triangles_[q];
-                            const double d = dot(xb - pt.a, pt.normal);
-                            if (q == farthest_q || d <= 0.0 || d * d >= best_cp.distance_squared) continue;
-                            const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
-                            if (cp.distance_squared < best_cp.distance_squared) {
-                                best = q;
-                                best_cp = cp;
-                                if (cp.feature == meshes::Feature::Face) break;
-                            }
-                        }
-                    }
-                    if (best_cp.distance_squared < r * r) push_triangle_hit(best, mw, xb, best_cp);
-                }
-                if (separated || farthest > 0.0) {
-                    k = end - 1;
-                    continue;
-                }
-                // a centre behind every candidate face is inside the body: the per-triangle search below
-            }
+            mw = &meshes_[mc.mesh];
+            xb = mw->to_body(x);
         }
         const PackedTriangle& pt = candidate_triangles_[k];
         // a triangle whose plane is r or more away cannot be touched: one dot product spares the closest point
@@ -928,7 +1001,10 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
         if (plane_distance >= r || plane_distance <= -r) continue;
         const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
         if (cp.distance_squared >= r * r) continue;
-        push_triangle_hit(k, mw, xb, cp);
+        const double dist = std::sqrt(cp.distance_squared);
+        const Vec3 normal = mw->rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : pt.normal);
+        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, cp.local_index, k,
+                  mw->to_world(cp.point), normal, r - dist, true});
     }
 
     // One contact per point of the surface that is locally closest to the centre:
@@ -1001,21 +1077,164 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
             c.first_step = false;
         }
 
-        const WallMotion& wall = wall_motion_[static_cast<std::size_t>(h.wall)];
-        const PairCoefficients& p = materials_.pair_unchecked(particles_.material[i], wall.material);
-        const Vec3 arm = h.point - x;
-        ContactState s;
-        s.overlap_m = h.overlap;
-        s.normal = h.normal;
-        s.relative_velocity_m_per_s = v + cross(w, arm) - wall.velocity_at(h.point);
-        s.relative_angular_velocity_rad_per_s = w - wall.angular_velocity_rad_per_s;
-        s.effective_radius_m = r;
-        s.effective_mass_kg = wall.mass_kg > 0.0 ? particles_.mass_kg[i] * wall.mass_kg / (particles_.mass_kg[i] + wall.mass_kg)
-                                                 : particles_.mass_kg[i];
-        s.normal_stiffness_N_per_m = wall_normal_stiffness(bulk_modulus_Pa_[particles_.material[i]], r, p.normal_stiffness_scale);
-        c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
-        c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
+        apply_wall_law(c, x, v, w, r, dt_s);
     }
+}
+
+void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const
+{
+    const std::uint32_t i = c.particle;
+    const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
+    const PairCoefficients& p = materials_.pair_unchecked(particles_.material[i], wall.material);
+    const Vec3 arm = c.point - x;
+    ContactState s;
+    s.overlap_m = c.overlap_m;
+    s.normal = c.normal;
+    s.relative_velocity_m_per_s = v + cross(w, arm) - wall.velocity_at(c.point);
+    s.relative_angular_velocity_rad_per_s = w - wall.angular_velocity_rad_per_s;
+    s.effective_radius_m = r;
+    s.effective_mass_kg = wall.mass_kg > 0.0 ? particles_.mass_kg[i] * wall.mass_kg / (particles_.mass_kg[i] + wall.mass_kg)
+                                             : particles_.mass_kg[i];
+    s.normal_stiffness_N_per_m = wall_normal_stiffness(bulk_modulus_Pa_[particles_.material[i]], r, p.normal_stiffness_scale);
+    c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
+    c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
+}
+
+std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s)
+{
+    // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in front of one
+    // of the faces within reach touches none of them. A centre in front of some face lies outside, and the hull's
+    // closest point then lies on a face it is in front of (the direction to it is in the normal cone there); a
+    // face whose interior holds its closest point holds the hull's. So one contact per body at most, from the
+    // faces the centre faces. A centre behind every face within reach is inside the body: it is pushed out
+    // through the nearest face plane (an overlap beyond the radius, which the overlap limit stops).
+    const MeshWall* mw = nullptr;
+    std::uint32_t body_mesh = kPlaneCandidate;
+    double slack = 0.0;
+    std::size_t touching = 0;
+    ContactConstants memo;
+    const WallMotion* memo_motion = nullptr;
+    std::int32_t memo_wall = -1;
+    double memo_r = -1.0, memo_m = -1.0;
+    MaterialIndex memo_material = 0;
+    // The pairs visit the particles out of order: their data is fetched a few pairs ahead (the loads of
+    // position, velocity and spin otherwise stall each pair).
+    constexpr std::size_t kAhead = 8;
+    auto prefetch = [&](const void* p) {
+#if defined(__GNUC__)
+        __builtin_prefetch(p);
+        __builtin_prefetch(static_cast<const char*>(p) + sizeof(Vec3) - 1);
+#else
+        (void)p;
+#endif
+    };
+    for (std::size_t k = begin; k < end; ++k) {
+        if (k + kAhead < end) {
+            const std::uint32_t ahead = convex_pairs_[k + kAhead].particle;
+            prefetch(&particles_.position_m[ahead]);
+            prefetch(&particles_.velocity_m_per_s[ahead]);
+            prefetch(&particles_.angular_velocity_rad_per_s[ahead]);
+        }
+        const ConvexPair pair = convex_pairs_[k];
+        if (pair.mesh != body_mesh) {
+            body_mesh = pair.mesh;
+            mw = &meshes_[pair.mesh];
+            slack = mw->convex_slack_m();
+        }
+        const std::uint32_t i = pair.particle;
+        const Vec3 x = particles_.position_m[i];
+        const double r = particles_.radius_m[i];
+        const Vec3 xb = mw->to_body(x);
+        const double clear = r + slack;
+        double farthest = -std::numeric_limits<double>::infinity();
+        std::uint32_t farthest_f = pair.face_begin;
+        bool separated = false;
+        for (std::uint32_t f = pair.face_begin; f < pair.face_end && !separated; ++f) {
+            const double d = dot(xb - convex_faces_[f].a, convex_faces_[f].normal);
+            separated = d >= clear;
+            if (d > farthest) {
+                farthest = d;
+                farthest_f = f;
+            }
+        }
+        bool touches = false;
+        Vec3 point_b, normal_b;
+        double overlap = 0.0;
+        std::uint32_t face = farthest_f;
+        if (!separated && farthest > 0.0) {
+            // the face the centre is farthest in front of comes first: when the closest point of a sphere on a
+            // face lies inside it, this is that face, and one query settles the body
+            const PackedTriangle& ft = convex_faces_[farthest_f];
+            meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
+            if (best_cp.feature != meshes::Feature::Face) {
+                for (std::uint32_t f = pair.face_begin; f < pair.face_end; ++f) {
+                    const PackedTriangle& pt = convex_faces_[f];
+                    const double d = dot(xb - pt.a, pt.normal);
+                    if (f == farthest_f || d <= 0.0 || d * d >= best_cp.distance_squared) continue;
+                    const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
+                    if (cp.distance_squared < best_cp.distance_squared) {
+                        face = f;
+                        best_cp = cp;
+                        if (cp.feature == meshes::Feature::Face) break;
+                    }
+                }
+            }
+            if (best_cp.distance_squared < r * r) {
+                touches = true;
+                const double dist = std::sqrt(best_cp.distance_squared);
+                point_b = best_cp.point;
+                normal_b = dist > 1e-12 * r ? (xb - best_cp.point) * (1.0 / dist) : convex_faces_[face].normal;
+                overlap = r - dist;
+            }
+        } else if (!separated) {
+            touches = true;
+            normal_b = convex_faces_[farthest_f].normal;
+            point_b = xb - normal_b * farthest;
+            overlap = r - farthest;
+        }
+        WallContact& c = convex_contacts_[k];
+        if (!touches) {
+            if (convex_touching_[k]) {  // separated: the history of this contact ends
+                convex_touching_[k] = 0;
+                convex_push_[k] = Push{};
+            }
+            continue;
+        }
+        ++touching;
+        c.first_step = !convex_touching_[k];
+        if (c.first_step) c.history = ContactHistory{};
+        convex_touching_[k] = 1;
+        c.particle = i;
+        c.wall = mesh_wall_id_[pair.mesh];
+        c.triangle = convex_face_triangle_[face];
+        c.normal = mw->rotation() * normal_b;
+        c.point = mw->to_world(point_b);
+        c.overlap_m = overlap;
+        const Vec3 v = particles_.velocity_m_per_s[i];
+        const Vec3 w = particles_.angular_velocity_rad_per_s[i];
+        // the constants of the law (eq. 4, 6, 8) change only with the particle's kind or the body: in a run of
+        // one body's pairs they are mostly computed once
+        const MaterialIndex mat = particles_.material[i];
+        const double m = particles_.mass_kg[i];
+        if (c.wall != memo_wall || r != memo_r || m != memo_m || mat != memo_material) {
+            memo_wall = c.wall;
+            memo_r = r;
+            memo_m = m;
+            memo_material = mat;
+            const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
+            const PairCoefficients& p = materials_.pair_unchecked(mat, wall.material);
+            memo = contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
+                                     wall.mass_kg > 0.0 ? m * wall.mass_kg / (m + wall.mass_kg) : m, r, p);
+            memo_motion = &wall;
+        }
+        const Vec3 relative_velocity = v + cross(w, c.point - x) - memo_motion->velocity_at(c.point);
+        c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - memo_motion->angular_velocity_rad_per_s, memo,
+                                         c.history, dt_s);
+        c.relative_displacement_m = relative_velocity * dt_s;
+        const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
+        convex_push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
+    }
+    return touching;
 }
 
 void World::wall_thread_block(int t, std::size_t& begin, std::size_t& end) const
@@ -1024,12 +1243,12 @@ void World::wall_thread_block(int t, std::size_t& begin, std::size_t& end) const
     // without one (the candidates sit at the bottom and the sides of a bed, so equal particle counts
     // would give one thread most of the work). Bounds from the candidates' prefix sum by bisection.
     const std::size_t n = particles_.size();
-    if (candidate_start_.size() != n + 1) {
+    if (wall_candidate_start_.size() != n + 1) {
         thread_block(n, t, threads_, begin, end);
         return;
     }
     constexpr std::size_t kCandidateWeight = 16;
-    auto weight = [&](std::size_t i) { return i + kCandidateWeight * candidate_start_[i]; };
+    auto weight = [&](std::size_t i) { return i + kCandidateWeight * wall_candidate_start_[i]; };
     const std::size_t total = weight(n);
     auto bound = [&](int q) {
         const std::size_t target = total * static_cast<std::size_t>(q) / static_cast<std::size_t>(threads_);
@@ -1060,7 +1279,8 @@ void World::compute_wall_contacts(double dt_s)
             wall_motion_[w] = {Vec3{}, Vec3{}, Vec3{}, 0.0, planes_[static_cast<std::size_t>(ref.index)].material};
         }
     }
-#pragma omp parallel num_threads(threads_)
+    std::size_t convex_touching = 0;
+#pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
         const int t = omp_get_thread_num();
         std::size_t begin, end;
@@ -1072,6 +1292,10 @@ void World::compute_wall_contacts(double dt_s)
         out.clear();
         if (any_wall)
             for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, hits, out);
+        // the spheres near convex bodies, body by body: each pair's contact in its place
+        const std::size_t pair_begin = convex_thread_start_[static_cast<std::size_t>(t)];
+        const std::size_t pair_end = convex_thread_start_[static_cast<std::size_t>(t) + 1];
+        convex_touching += compute_convex_contacts(pair_begin, pair_end, dt_s);
 
         // Last step's contacts have been read (their history): each thread's contacts, in particle order,
         // replace them at the thread's offset, and each thread indexes its own particles.
@@ -1097,6 +1321,7 @@ void World::compute_wall_contacts(double dt_s)
                 thread_wall_torque_N_m_[q].resize(walls_.size());
             }
             thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
+            thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
         }
         std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
         const auto& filled = threads_ == 1 ? wall_contacts_ : thread_wall_contacts_[static_cast<std::size_t>(t)];
@@ -1124,7 +1349,20 @@ void World::compute_wall_contacts(double dt_s)
                 first_deep = offset + q;
         }
         thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
+        std::size_t first_deep_convex = kNoContact;
+        for (std::size_t p = pair_begin; p < pair_end; ++p) {
+            if (!convex_touching_[p]) continue;
+            const WallContact& c = convex_contacts_[p];
+            const auto w = static_cast<std::size_t>(c.wall);
+            const Vec3 on_wall = -convex_push_[p].force_N;
+            wall_force[w] += on_wall;
+            wall_torque[w] += cross(c.point - wall_motion_[w].reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
+            if (first_deep_convex == kNoContact && c.overlap_m / particles_.radius_m[c.particle] > settings_.max_overlap_ratio)
+                first_deep_convex = p;
+        }
+        thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
     }
+    convex_contact_count_ = convex_touching;
     records_stale_ = true;
 }
 
@@ -1156,6 +1394,11 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
             const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
             f += force;
             torque += cross(c.point - x[i], force) + c.forces.rolling_torque_N_m;
+        }
+        for (std::uint32_t k = convex_pair_start_[i]; k < convex_pair_start_[i + 1]; ++k) {
+            const Push& push = convex_push_[convex_pair_index_[k]];
+            f += push.force_N;
+            torque += push.torque_N_m;
         }
         if (!next_drift) {  // within a run of steps the force is used here and nowhere else
             particles_.force_N[i] = f;
@@ -1335,8 +1578,16 @@ void World::write_state(StateWriter& out) const
     out.array(reference_mesh_version_);
     out.value(skin_m_);
     out.tag("wall-contacts");
-    out.array(wall_contacts_);
-    out.array(wall_contact_start_);
+    // one list sorted by particle, those on convex bodies included (read_state splits it again)
+    const std::vector<WallContact> contacts = merged_wall_contacts();
+    std::vector<std::uint32_t> contact_start;
+    if (!wall_contact_start_.empty()) {
+        contact_start.assign(wall_contact_start_.size(), 0);
+        for (const WallContact& c : contacts) ++contact_start[c.particle + 1];
+        std::partial_sum(contact_start.begin(), contact_start.end(), contact_start.begin());
+    }
+    out.array(contacts);
+    out.array(contact_start);
     out.array(candidate_start_);
     out.array(candidates_);
     out.array(wall_force_N_);
@@ -1418,6 +1669,8 @@ void World::read_state(StateReader& in)
         in.fail("contact index arrays do not match the particle count");
     if (!wall_contact_start_.empty() && wall_contact_start_.back() != wall_contacts_.size()) in.fail("wall contact index mismatch");
     if (!candidate_start_.empty() && candidate_start_.back() != candidates_.size()) in.fail("wall candidate index mismatch");
+    if (!std::is_sorted(candidate_start_.begin(), candidate_start_.end()) || !std::is_sorted(wall_contact_start_.begin(), wall_contact_start_.end()))
+        in.fail("a wall contact or candidate index that does not ascend");
     for (const MeshCandidate& c : candidates_) {
         if (c.triangle == kPlaneCandidate ? c.mesh >= planes_.size() : (c.mesh >= meshes_.size() || c.triangle >= meshes_[c.mesh].mesh().triangle_count()))
             in.fail("a wall candidate out of range");
@@ -1425,7 +1678,8 @@ void World::read_state(StateReader& in)
     if (reference_mesh_version_.size() != reference_mesh_rotation_.size() ||
         reference_mesh_translation_m_.size() != reference_mesh_rotation_.size())
         in.fail("mesh reference arrays differ in length");
-    copy_candidate_triangles();
+    split_candidates();
+    split_convex_contacts();
     if (wall_force_N_.size() != walls_.size() || wall_torque_N_m_.size() != walls_.size())
         wall_force_N_.assign(walls_.size(), Vec3{}), wall_torque_N_m_.assign(walls_.size(), Vec3{});
     records_.clear();

@@ -12,6 +12,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dipper::dem {
@@ -130,7 +131,7 @@ public:
     /// Surface contacts of the last step.
     const std::vector<ContactRecord>& last_contact_records() const;  ///< built when first asked for
     std::size_t pair_contact_count() const;          ///< touching sphere pairs in the last step
-    std::size_t wall_contact_count() const { return wall_contacts_.size(); }
+    std::size_t wall_contact_count() const { return wall_contacts_.size() + convex_contact_count_; }
     std::size_t neighbour_pair_count() const { return pair_i_.size(); }
     double max_overlap_ratio() const { return max_overlap_ratio_; }  ///< largest overlap / smaller radius, last step
     std::vector<PairContactView> pair_contacts() const;
@@ -187,7 +188,17 @@ private:
     bool needs_rebuild(double particle_move_m) const;
     void rebuild();
     void build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
-    void copy_candidate_triangles();
+    /// Splits candidates_ into the per-particle lists of planes and open meshes, with their triangles beside
+    /// them, and the pairs of spheres and convex bodies, sorted by body.
+    void split_candidates();
+    /// Moves the history of wall_contacts_ on convex bodies into their pairs; the rest stay, indexed by particle.
+    void split_convex_contacts();
+    /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
+    std::vector<WallContact> merged_wall_contacts() const;
+    /// The contacts of convex pairs begin..end-1; returns how many touch.
+    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s);
+    /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
+    void apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const;
     void evaluate_forces(double dt_s, double half_kick_s);
     void compute_pair_forces(double dt_s);
     void compute_wall_contacts(double dt_s);
@@ -242,9 +253,33 @@ private:
     std::vector<std::uint32_t> wall_contact_start_;
     std::vector<std::size_t> wall_contact_offset_;  ///< per-thread offsets into wall_contacts_, this step
     std::vector<std::uint32_t> candidate_start_;
-    std::vector<MeshCandidate> candidates_;
-    std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside candidates_ (planes: unused)
-    std::vector<TriangleIds> candidate_ids_;           ///< beside candidates_, read only for touched triangles
+    std::vector<MeshCandidate> candidates_;            ///< every wall within reach of each particle, as found
+    // the planes and the triangles of open meshes, per particle (candidates_ less the convex bodies)
+    std::vector<std::uint32_t> wall_candidate_start_;
+    std::vector<MeshCandidate> wall_candidates_;
+    std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside wall_candidates_ (planes: unused)
+    std::vector<TriangleIds> candidate_ids_;           ///< beside wall_candidates_, read only for touched triangles
+    /// A sphere within reach of a convex body (a rock's hull): at most one contact (find the reason at
+    /// compute_convex_contacts), kept in place from step to step like a sphere pair's. The pairs are sorted by
+    /// thread, then by body, so that one body's pose and faces serve all the spheres near it in a row.
+    struct ConvexPair { std::uint32_t mesh, particle, face_begin, face_end; };
+    std::vector<ConvexPair> convex_pairs_;
+    std::vector<PackedTriangle> convex_faces_;       ///< body frame, the faces within reach of each pair in turn
+    std::vector<std::int32_t> convex_face_triangle_; ///< beside convex_faces_: the mesh's triangle
+    std::vector<WallContact> convex_contacts_;       ///< beside convex_pairs_: the contact of this step, if touching
+    std::vector<std::uint8_t> convex_touching_;      ///< beside convex_pairs_
+    struct Push { Vec3 force_N, torque_N_m; };       ///< on the particle, about its centre
+    std::vector<Push> convex_push_;                  ///< beside convex_pairs_ (zero when apart)
+    std::vector<std::uint32_t> convex_pair_start_, convex_pair_index_;  ///< each particle's pairs
+    std::vector<std::size_t> convex_thread_start_;   ///< the pairs of each thread (those of its particles)
+    std::size_t convex_contact_count_ = 0;
+    std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit
+    /// The wall-candidate search's large working lists, kept for their capacity.
+    struct CandidateScratch {
+        std::vector<std::pair<std::uint32_t, MeshCandidate>> entries;  ///< (cell, triangle)
+        std::vector<MeshCandidate> bucket;                             ///< triangles by cell
+        std::vector<std::vector<MeshCandidate>> per_thread;
+    } scratch_;
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
