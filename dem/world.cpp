@@ -1117,24 +1117,7 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
     std::int32_t memo_wall = -1;
     double memo_r = -1.0, memo_m = -1.0;
     MaterialIndex memo_material = 0;
-    // The pairs visit the particles out of order: their data is fetched a few pairs ahead (the loads of
-    // position, velocity and spin otherwise stall each pair).
-    constexpr std::size_t kAhead = 8;
-    auto prefetch = [&](const void* p) {
-#if defined(__GNUC__)
-        __builtin_prefetch(p);
-        __builtin_prefetch(static_cast<const char*>(p) + sizeof(Vec3) - 1);
-#else
-        (void)p;
-#endif
-    };
     for (std::size_t k = begin; k < end; ++k) {
-        if (k + kAhead < end) {
-            const std::uint32_t ahead = convex_pairs_[k + kAhead].particle;
-            prefetch(&particles_.position_m[ahead]);
-            prefetch(&particles_.velocity_m_per_s[ahead]);
-            prefetch(&particles_.angular_velocity_rad_per_s[ahead]);
-        }
         const ConvexPair pair = convex_pairs_[k];
         if (pair.mesh != body_mesh) {
             body_mesh = pair.mesh;
