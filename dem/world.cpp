@@ -1100,7 +1100,8 @@ void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const V
     c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
 }
 
-std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s)
+std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, Vec3* __restrict wall_force,
+                                           Vec3* __restrict wall_torque, std::size_t& first_deep)
 {
     // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in front of one
     // of the faces within reach touches none of them. A centre in front of some face lies outside, and the hull's
@@ -1216,6 +1217,12 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         c.relative_displacement_m = relative_velocity * dt_s;
         const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
         convex_push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
+        // the body's reaction, while the contact is in cache (a body's sum holds only its own pairs, in order)
+        const auto w_id = static_cast<std::size_t>(c.wall);
+        const Vec3 on_wall = -force;
+        wall_force[w_id] += on_wall;
+        wall_torque[w_id] += cross(c.point - memo_motion->reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
+        if (first_deep == kNoContact && c.overlap_m / r > settings_.max_overlap_ratio) first_deep = k;
     }
     return touching;
 }
@@ -1263,11 +1270,25 @@ void World::compute_wall_contacts(double dt_s)
         }
     }
     std::size_t convex_touching = 0;
+    thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));
+    thread_wall_torque_N_m_.resize(static_cast<std::size_t>(threads_));
+    for (std::size_t q = 0; q < static_cast<std::size_t>(threads_); ++q) {
+        thread_wall_force_N_[q].resize(walls_.size());
+        thread_wall_torque_N_m_[q].resize(walls_.size());
+    }
+    thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
+    thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         wall_thread_block(t, begin, end);
+        // the thread's share of each wall's reaction: a convex body's from its pairs below, the others' from
+        // the thread's contacts after the barrier (no wall has both)
+        Vec3* __restrict wall_force = thread_wall_force_N_[static_cast<std::size_t>(t)].data();
+        Vec3* __restrict wall_torque = thread_wall_torque_N_m_[static_cast<std::size_t>(t)].data();
+        std::fill(wall_force, wall_force + walls_.size(), Vec3{});
+        std::fill(wall_torque, wall_torque + walls_.size(), Vec3{});
         // the thread's vectors are moved into locals while it fills them: their headers sit side by side in
         // one cache line, and a push_back into the shared arrays would bounce that line between the cores
         std::vector<WallContact> out = std::move(thread_wall_contacts_[static_cast<std::size_t>(t)]);
@@ -1278,7 +1299,9 @@ void World::compute_wall_contacts(double dt_s)
         // the spheres near convex bodies, body by body: each pair's contact in its place
         const std::size_t pair_begin = convex_thread_start_[static_cast<std::size_t>(t)];
         const std::size_t pair_end = convex_thread_start_[static_cast<std::size_t>(t) + 1];
-        convex_touching += compute_convex_contacts(pair_begin, pair_end, dt_s);
+        std::size_t first_deep_convex = kNoContact;
+        convex_touching += compute_convex_contacts(pair_begin, pair_end, dt_s, wall_force, wall_torque, first_deep_convex);
+        thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
 
         // Last step's contacts have been read (their history): each thread's contacts, in particle order,
         // replace them at the thread's offset, and each thread indexes its own particles.
@@ -1297,14 +1320,6 @@ void World::compute_wall_contacts(double dt_s)
                 wall_contacts_.resize(wall_contact_offset_.back());
             wall_contact_start_.resize(n + 1);
             wall_contact_start_[n] = static_cast<std::uint32_t>(wall_contacts_.size());
-            thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));
-            thread_wall_torque_N_m_.resize(static_cast<std::size_t>(threads_));
-            for (std::size_t q = 0; q < static_cast<std::size_t>(threads_); ++q) {
-                thread_wall_force_N_[q].resize(walls_.size());
-                thread_wall_torque_N_m_[q].resize(walls_.size());
-            }
-            thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
-            thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
         }
         std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
         const auto& filled = threads_ == 1 ? wall_contacts_ : thread_wall_contacts_[static_cast<std::size_t>(t)];
@@ -1314,12 +1329,8 @@ void World::compute_wall_contacts(double dt_s)
             while (k < wall_contact_offset_[static_cast<std::size_t>(t) + 1] && wall_contacts_[k].particle == i) ++k;
         }
 
-        // the thread's share of each wall's reaction, in list order, and its first contact past the
+        // the reaction of the planes and open meshes, in list order, and the thread's first contact past the
         // overlap limit
-        Vec3* __restrict wall_force = thread_wall_force_N_[static_cast<std::size_t>(t)].data();
-        Vec3* __restrict wall_torque = thread_wall_torque_N_m_[static_cast<std::size_t>(t)].data();
-        std::fill(wall_force, wall_force + walls_.size(), Vec3{});
-        std::fill(wall_torque, wall_torque + walls_.size(), Vec3{});
         std::size_t first_deep = kNoContact;
         const std::size_t offset = wall_contact_offset_[static_cast<std::size_t>(t)];
         for (std::size_t q = 0; q < filled.size(); ++q) {
@@ -1332,18 +1343,6 @@ void World::compute_wall_contacts(double dt_s)
                 first_deep = offset + q;
         }
         thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
-        std::size_t first_deep_convex = kNoContact;
-        for (std::size_t p = pair_begin; p < pair_end; ++p) {
-            if (!convex_touching_[p]) continue;
-            const WallContact& c = convex_contacts_[p];
-            const auto w = static_cast<std::size_t>(c.wall);
-            const Vec3 on_wall = -convex_push_[p].force_N;
-            wall_force[w] += on_wall;
-            wall_torque[w] += cross(c.point - wall_motion_[w].reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
-            if (first_deep_convex == kNoContact && c.overlap_m / particles_.radius_m[c.particle] > settings_.max_overlap_ratio)
-                first_deep_convex = p;
-        }
-        thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
     }
     convex_contact_count_ = convex_touching;
     records_stale_ = true;

@@ -196,7 +196,10 @@ private:
     /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
     std::vector<WallContact> merged_wall_contacts() const;
     /// The contacts of convex pairs begin..end-1; returns how many touch.
-    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s);
+    /// The contacts of convex pairs [begin, end), with their bodies' reactions added to wall_force and
+    /// wall_torque and the first pair past the overlap limit in first_deep; returns how many touch.
+    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, Vec3* __restrict wall_force,
+                                        Vec3* __restrict wall_torque, std::size_t& first_deep);
     /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
     void apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const;
     void evaluate_forces(double dt_s, double half_kick_s);

@@ -376,6 +376,50 @@ TEST_CASE("contacts on a convex body keep their history over neighbour-list rebu
     }
 }
 
+TEST_CASE("a sphere whose centre lies inside a convex body is pushed out through the nearest face and stops the run",
+          "[dem][walls][unit]")
+{
+    // A centre behind every face plane of a convex body gets one contact on the face whose plane is nearest: the
+    // normal of that face, the point on its plane, an overlap of r plus the depth. That overlap exceeds the radius,
+    // so the overlap limit (at most 1 r) always stops the run with a diagnosis naming the body and the depth.
+    // Box [0, 1]^3, r = 0.1 m, centre (0.99, 0.5, 0.98): 0.01 m inside the side x = 1 and 0.02 m below the top,
+    // both within the skin (0.03 m) so both are candidates; the side is nearest: normal +x, point x = 1, overlap
+    // 0.11 m. The records and the diagnosis come from the end of the step, after the push has moved the centre
+    // out by about a millimetre: the overlap is then r + (1 - x) at that centre (to round-off of coordinates near
+    // 1 m, hence the 1e-12 margins).
+    WorldSettings settings;
+    settings.gravity_m_per_s2 = {};
+    World w(test::two_material_table(kSticky, 3700.0, 45e9, 0.3), settings);
+    w.add_mesh(meshes::make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}), 1, "box");
+    const double r = 0.1;
+    w.add_particle({{0.99, 0.5, 0.98}, {}, {}, r, 0});
+    std::vector<ContactRecord> seen;
+    w.set_contact_consumer([&](const std::vector<ContactRecord>& records, double, double) { seen = records; });
+    std::string message;
+    try {
+        w.step();
+    } catch (const SimulationError& e) {
+        message = e.what();
+    }
+    INFO(message);
+    REQUIRE(seen.size() == 1);
+    CHECK(seen[0].normal_world.x == Approx(1.0).margin(1e-12));
+    CHECK(std::abs(seen[0].normal_world.y) + std::abs(seen[0].normal_world.z) < 1e-12);
+    const Vec3 x = w.particles().position_m[0];
+    CHECK(x.x > 0.99);  // pushed out along +x, the nearest face, not through the top
+    CHECK(x.x < 1.0);
+    CHECK(x.z == Approx(0.98).margin(1e-12));
+    CHECK(seen[0].point_world.x == Approx(1.0).margin(1e-12));
+    CHECK(seen[0].point_world.z == Approx(0.98).margin(1e-12));
+    CHECK(seen[0].overlap_m == Approx(r + (1.0 - x.x)).margin(1e-12));
+    CHECK(seen[0].overlap_m > 0.1);
+    CHECK(seen[0].normal_force_N > 0.0);
+    CHECK_THAT(message, Catch::Contains("overlaps wall 'box'"));
+    const std::size_t by = message.find(" by ");
+    REQUIRE(by != std::string::npos);
+    CHECK(std::stod(message.substr(by + 4)) == Approx(seen[0].overlap_m / r).margin(1e-5));  // printed to 6 digits
+}
+
 TEST_CASE("an open plate is touched from both sides", "[dem][walls][unit]")
 {
     // An open surface is two-sided (a door or a pan is met from either side): a sphere resting 40 mm into a
