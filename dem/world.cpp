@@ -407,7 +407,7 @@ void World::finish_step(double dt_s)
 const std::vector<ContactRecord>& World::last_contact_records() const
 {
     if (!records_stale_) return records_;
-    // the contacts of planes and open meshes in particle order, then those of convex bodies, body by body
+    // the contacts of planes and open meshes in particle order, then those of convex bodies, in particle order
     std::vector<const WallContact*> contacts(wall_contacts_.size());
     for (std::size_t k = 0; k < wall_contacts_.size(); ++k) contacts[k] = &wall_contacts_[k];
     for (std::size_t k = 0; k < convex_pairs_.size(); ++k)
@@ -713,18 +713,17 @@ void World::split_candidates()
 {
     // Planes and open meshes stay with their particle; a convex body's triangles become one pair of the sphere
     // and that body, with the faces copied beside it (candidates_ lists a particle's triangles mesh by mesh, so a
-    // body's faces are one run). Each thread takes the pairs of the particles whose forces it gathers
-    // (thread_block, as the gather's static schedule), body by body: a counting sort on (thread, body), stable,
-    // so by particle within a body. Two passes over the candidates, no copy of them.
+    // body's faces are one run). The pairs are in particle order: the spheres' state is then read in one sweep,
+    // and each thread's pairs, those of the particles whose forces it gathers (thread_block, as the gather's
+    // static schedule), are one block.
     const std::size_t n = candidate_start_.empty() ? 0 : candidate_start_.size() - 1;
-    const std::size_t bodies = meshes_.size();
-    std::vector<std::uint32_t> key_start(static_cast<std::size_t>(threads_) * bodies + 1, 0);
-    auto each_convex_run = [&](auto&& visit) {
-        int t = 0;
-        std::size_t block_begin = 0, block_end = 0;
-        thread_block(n, t, threads_, block_begin, block_end);
-        for (std::size_t i = 0; i < n; ++i) {
-            while (i >= block_end && t + 1 < threads_) thread_block(n, ++t, threads_, block_begin, block_end);
+    convex_pairs_.clear();
+    convex_thread_start_.assign(static_cast<std::size_t>(threads_) + 1, 0);
+    for (int t = 0; t < threads_; ++t) {
+        std::size_t begin, end;
+        thread_block(n, t, threads_, begin, end);
+        convex_thread_start_[static_cast<std::size_t>(t)] = convex_pairs_.size();
+        for (std::size_t i = begin; i < end; ++i) {
             for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1];) {
                 const MeshCandidate mc = candidates_[k];
                 if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) {
@@ -733,17 +732,12 @@ void World::split_candidates()
                 }
                 std::uint32_t run_end = k + 1;
                 while (run_end < candidate_start_[i + 1] && candidates_[run_end].mesh == mc.mesh) ++run_end;
-                visit(static_cast<std::size_t>(t) * bodies + mc.mesh, ConvexPair{mc.mesh, static_cast<std::uint32_t>(i), k, run_end});
+                convex_pairs_.push_back({mc.mesh, static_cast<std::uint32_t>(i), k, run_end});
                 k = run_end;
             }
         }
-    };
-    each_convex_run([&](std::size_t key, const ConvexPair&) { ++key_start[key + 1]; });
-    std::partial_sum(key_start.begin(), key_start.end(), key_start.begin());
-    convex_thread_start_.resize(static_cast<std::size_t>(threads_) + 1);
-    for (int t = 0; t <= threads_; ++t) convex_thread_start_[static_cast<std::size_t>(t)] = key_start[static_cast<std::size_t>(t) * bodies];
-    convex_pairs_.resize(key_start.back());
-    each_convex_run([&](std::size_t key, const ConvexPair& p) { convex_pairs_[key_start[key]++] = p; });
+    }
+    convex_thread_start_[static_cast<std::size_t>(threads_)] = convex_pairs_.size();
 
     // the faces beside the pairs, in pair order
     convex_faces_.clear();
@@ -1100,6 +1094,45 @@ void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const V
     c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
 }
 
+namespace {
+
+bool same_point(const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; }
+bool has_vertex(const PackedTriangle& t, const Vec3& v) { return same_point(t.a, v) || same_point(t.b, v) || same_point(t.c, v); }
+/// The end points of edge k of a triangle, in the numbering of meshes::ClosestPoint (ab, bc, ca).
+std::pair<Vec3, Vec3> edge_ends(const PackedTriangle& t, int k) { return k == 0 ? std::pair{t.a, t.b} : k == 1 ? std::pair{t.b, t.c} : std::pair{t.c, t.a}; }
+
+}  // namespace
+
+bool World::edge_point_is_closest(const ConvexPair& pair, std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
+                                  std::uint32_t& best_face) const
+{
+    // The closest point q of face F lies on its edge E. In a closed convex mesh E has one more face, G; q is the
+    // body's closest point when it is G's too (then x - q lies in the normal cone of E), or when x lies behind
+    // G's plane (then it lies in that cone by F's own condition). A point of G's interior, or of E computed from
+    // G and closer by round-off, is taken instead, as the search over all faces would take it. Anything else,
+    // or G not among the pair's faces, leaves the answer to that search (returns false, `best` as it came).
+    const auto [e0, e1] = edge_ends(convex_faces_[face_f], best.local_index);
+    for (std::uint32_t g = pair.face_begin; g < pair.face_end; ++g) {
+        const PackedTriangle& gt = convex_faces_[g];
+        if (g == face_f || !has_vertex(gt, e0) || !has_vertex(gt, e1)) continue;
+        const double d = dot(xb - gt.a, gt.normal);
+        if (d <= 0.0 || d * d >= best.distance_squared) return true;
+        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, gt.a, gt.b, gt.c);
+        bool on_e = cp.feature == meshes::Feature::Face;
+        if (cp.feature == meshes::Feature::Edge) {
+            const auto [g0, g1] = edge_ends(gt, cp.local_index);
+            on_e = (same_point(g0, e0) && same_point(g1, e1)) || (same_point(g0, e1) && same_point(g1, e0));
+        }
+        if (!on_e && cp.distance_squared < best.distance_squared) return false;
+        if (cp.distance_squared < best.distance_squared) {
+            best = cp;
+            best_face = g;
+        }
+        return true;
+    }
+    return false;
+}
+
 std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, Vec3* __restrict wall_force,
                                            Vec3* __restrict wall_torque, std::size_t& first_deep)
 {
@@ -1113,11 +1146,6 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
     std::uint32_t body_mesh = kPlaneCandidate;
     double slack = 0.0;
     std::size_t touching = 0;
-    ContactConstants memo;
-    const WallMotion* memo_motion = nullptr;
-    std::int32_t memo_wall = -1;
-    double memo_r = -1.0, memo_m = -1.0;
-    MaterialIndex memo_material = 0;
     for (std::size_t k = begin; k < end; ++k) {
         const ConvexPair pair = convex_pairs_[k];
         if (pair.mesh != body_mesh) {
@@ -1150,7 +1178,9 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
             // face lies inside it, this is that face, and one query settles the body
             const PackedTriangle& ft = convex_faces_[farthest_f];
             meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
-            if (best_cp.feature != meshes::Feature::Face) {
+            if (best_cp.feature == meshes::Feature::Edge && edge_point_is_closest(pair, farthest_f, xb, best_cp, face)) {
+                // settled by the face across the edge (most closest points off a face lie on an edge)
+            } else if (best_cp.feature != meshes::Feature::Face) {
                 for (std::uint32_t f = pair.face_begin; f < pair.face_end; ++f) {
                     const PackedTriangle& pt = convex_faces_[f];
                     const double d = dot(xb - pt.a, pt.normal);
@@ -1196,23 +1226,16 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         c.overlap_m = overlap;
         const Vec3 v = particles_.velocity_m_per_s[i];
         const Vec3 w = particles_.angular_velocity_rad_per_s[i];
-        // the constants of the law (eq. 4, 6, 8) change only with the particle's kind or the body: in a run of
-        // one body's pairs they are mostly computed once
+        // the constants of the law (eq. 4, 6, 8) of this sphere's kind against this body
         const MaterialIndex mat = particles_.material[i];
         const double m = particles_.mass_kg[i];
-        if (c.wall != memo_wall || r != memo_r || m != memo_m || mat != memo_material) {
-            memo_wall = c.wall;
-            memo_r = r;
-            memo_m = m;
-            memo_material = mat;
-            const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
-            const PairCoefficients& p = materials_.pair_unchecked(mat, wall.material);
-            memo = contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
-                                     wall.mass_kg > 0.0 ? m * wall.mass_kg / (m + wall.mass_kg) : m, r, p);
-            memo_motion = &wall;
-        }
-        const Vec3 relative_velocity = v + cross(w, c.point - x) - memo_motion->velocity_at(c.point);
-        c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - memo_motion->angular_velocity_rad_per_s, memo,
+        const WallMotion& motion = wall_motion_[static_cast<std::size_t>(c.wall)];
+        const PairCoefficients& p = materials_.pair_unchecked(mat, motion.material);
+        const ContactConstants constants =
+            contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
+                              motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r, p);
+        const Vec3 relative_velocity = v + cross(w, c.point - x) - motion.velocity_at(c.point);
+        c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - motion.angular_velocity_rad_per_s, constants,
                                          c.history, dt_s);
         c.relative_displacement_m = relative_velocity * dt_s;
         const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
@@ -1221,7 +1244,7 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         const auto w_id = static_cast<std::size_t>(c.wall);
         const Vec3 on_wall = -force;
         wall_force[w_id] += on_wall;
-        wall_torque[w_id] += cross(c.point - memo_motion->reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
+        wall_torque[w_id] += cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
         if (first_deep == kNoContact && c.overlap_m / r > settings_.max_overlap_ratio) first_deep = k;
     }
     return touching;
@@ -1296,7 +1319,7 @@ void World::compute_wall_contacts(double dt_s)
         out.clear();
         if (any_wall)
             for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, hits, out);
-        // the spheres near convex bodies, body by body: each pair's contact in its place
+        // the spheres near convex bodies, in particle order: each pair's contact in its place
         const std::size_t pair_begin = convex_thread_start_[static_cast<std::size_t>(t)];
         const std::size_t pair_end = convex_thread_start_[static_cast<std::size_t>(t) + 1];
         std::size_t first_deep_convex = kNoContact;

@@ -189,7 +189,7 @@ private:
     void rebuild();
     void build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
     /// Splits candidates_ into the per-particle lists of planes and open meshes, with their triangles beside
-    /// them, and the pairs of spheres and convex bodies, sorted by body.
+    /// them, and the pairs of spheres and convex bodies, in particle order.
     void split_candidates();
     /// Moves the history of wall_contacts_ on convex bodies into their pairs; the rest stay, indexed by particle.
     void split_convex_contacts();
@@ -263,9 +263,13 @@ private:
     std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside wall_candidates_ (planes: unused)
     std::vector<TriangleIds> candidate_ids_;           ///< beside wall_candidates_, read only for touched triangles
     /// A sphere within reach of a convex body (a rock's hull): at most one contact (find the reason at
-    /// compute_convex_contacts), kept in place from step to step like a sphere pair's. The pairs are sorted by
-    /// thread, then by body, so that one body's pose and faces serve all the spheres near it in a row.
+    /// compute_convex_contacts), kept in place from step to step like a sphere pair's. The pairs are in particle
+    /// order, so that the spheres' state is read in one sweep (each thread's pairs are one block of them).
     struct ConvexPair { std::uint32_t mesh, particle, face_begin, face_end; };
+    /// Whether `best`, the closest point of face face_f of a convex pair on one of its edges, is the body's:
+    /// decided from the face across that edge, which may replace it (`best`, `best_face`).
+    bool edge_point_is_closest(const ConvexPair& pair, std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
+                               std::uint32_t& best_face) const;
     std::vector<ConvexPair> convex_pairs_;
     std::vector<PackedTriangle> convex_faces_;       ///< body frame, the faces within reach of each pair in turn
     std::vector<std::int32_t> convex_face_triangle_; ///< beside convex_faces_: the mesh's triangle

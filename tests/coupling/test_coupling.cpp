@@ -11,6 +11,7 @@
 #include <ccd/ccd.h>
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <random>
 
@@ -149,6 +150,63 @@ TEST_CASE("sphere-hull contact agrees with libccd's penetration depth and direct
     CHECK(worst_separation < 1e-12);
     CHECK(worst_depth < 2e-6);
     CHECK(worst_angle < 1e-2);
+}
+
+TEST_CASE("a sphere near a rock's edge or vertex gets the hull's exact closest point", "[coupling][unit]")
+{
+    // Most closest points of a sphere on a rock that are not inside a face lie on an edge, and the DEM settles
+    // those from the two faces of the edge alone; the rest take the search over all faces within reach. Spheres
+    // at random places 0.3-1.15 r from a generated rock must each get the overlap r - d and the direction of the
+    // hull's exact distance d, found here by brute force over every triangle of the rock (the feature that holds
+    // the closest point comes with it, so that edges and vertices are seen to be exercised in numbers). Two rocks:
+    // one of the bed's kind, and a long one of few points with sharp edges and corners, where the face across an
+    // edge is often out of the sphere's reach and the search over all faces decides.
+    const auto [rock, seed] = GENERATE(table<rigid::ConvexPolyhedron, std::uint64_t>(
+        {{test_rock(0.4, 29), 31}, {rigid::generate_rock({0.6, 3.0, 4.0, 8}, 32).in_principal_frame(), 33}}));
+    const meshes::TriangleMesh mesh = rock.to_mesh();
+    const dem::MaterialTable materials = dem::MaterialTable::aitik_copper_ore();
+    const double r = 0.3;  // large beside the rock: spheres reach round its edges and corners, where it is least flat
+    const double kn = materials.material(materials.index_of("ore")).bulk_modulus_Pa() * r *
+                      materials.pair(materials.index_of("ore"), materials.index_of("rock")).normal_stiffness_scale;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-0.8, 0.8);
+    int on_face = 0, on_edge = 0, on_vertex = 0, apart = 0;
+    double worst_overlap = 0.0, worst_direction = 0.0;
+    while (on_face + on_edge + on_vertex + apart < 600) {
+        const Vec3 centre{u(rng), u(rng), u(rng)};
+        meshes::ClosestPoint best;
+        best.distance_squared = std::numeric_limits<double>::infinity();
+        for (const auto& t : mesh.triangles()) {
+            const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(centre, mesh.vertices_m()[t[0]], mesh.vertices_m()[t[1]],
+                                                                              mesh.vertices_m()[t[2]]);
+            if (cp.distance_squared < best.distance_squared) best = cp;
+        }
+        const double d = std::sqrt(best.distance_squared);
+        if (mesh.contains(centre) || d < 0.3 * r || d > 1.15 * r) continue;
+        dem::World w(materials, dem::WorldSettings{});
+        w.add_mesh(mesh, materials.index_of("rock"), "rock");
+        add_sphere(w, centre, {}, r);
+        w.prepare();
+        const Vec3 f = w.wall_force_N(0);
+        if (d >= r) {
+            CHECK(norm(f) == 0.0);
+            ++apart;
+            continue;
+        }
+        // a closest point on a shared edge or vertex is found by several triangles: the first one's feature counts
+        (best.feature == meshes::Feature::Face ? on_face : best.feature == meshes::Feature::Edge ? on_edge : on_vertex)++;
+        worst_overlap = std::max(worst_overlap, std::abs(norm(f) / kn - (r - d)));
+        worst_direction = std::max(worst_direction, norm(normalized(f) * -1.0 - (centre - best.point) * (1.0 / d)));
+    }
+    std::printf("sphere near a rock: %d on a face, %d on an edge, %d on a vertex, %d apart; worst overlap error %.3g m, "
+                "worst direction error %.3g\n", on_face, on_edge, on_vertex, apart, worst_overlap, worst_direction);
+    CHECK(on_edge > 50);
+    CHECK(on_vertex > 10);
+    CHECK(on_face > 50);
+    CHECK(apart > 50);
+    // the same point from the same or the neighbouring triangle: round-off of coordinates near 0.3 m
+    CHECK(worst_overlap < 1e-12);
+    CHECK(worst_direction < 1e-9);
 }
 
 TEST_CASE("a sphere dropped on a fixed rock rebounds as on a fixed mesh copy of it", "[coupling][unit]")
