@@ -1096,8 +1096,7 @@ void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const V
 
 namespace {
 
-bool same_point(const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; }
-bool has_vertex(const PackedTriangle& t, const Vec3& v) { return same_point(t.a, v) || same_point(t.b, v) || same_point(t.c, v); }
+bool has_vertex(const PackedTriangle& t, const Vec3& v) { return t.a == v || t.b == v || t.c == v; }
 /// The end points of edge k of a triangle, in the numbering of meshes::ClosestPoint (ab, bc, ca).
 std::pair<Vec3, Vec3> edge_ends(const PackedTriangle& t, int k) { return k == 0 ? std::pair{t.a, t.b} : k == 1 ? std::pair{t.b, t.c} : std::pair{t.c, t.a}; }
 
@@ -1121,7 +1120,7 @@ bool World::edge_point_is_closest(const ConvexPair& pair, std::uint32_t face_f, 
         bool on_e = cp.feature == meshes::Feature::Face;
         if (cp.feature == meshes::Feature::Edge) {
             const auto [g0, g1] = edge_ends(gt, cp.local_index);
-            on_e = (same_point(g0, e0) && same_point(g1, e1)) || (same_point(g0, e1) && same_point(g1, e0));
+            on_e = (g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0);
         }
         if (!on_e && cp.distance_squared < best.distance_squared) return false;
         if (cp.distance_squared < best.distance_squared) {
