@@ -64,6 +64,14 @@ struct Mat3 {
     }
 };
 
+/// a^T v, with the products and sums of (a.transposed() * v), so the same bits.
+constexpr Vec3 transposed_times(const Mat3& a, const Vec3& v)
+{
+    return {a.m[0][0] * v.x + a.m[1][0] * v.y + a.m[2][0] * v.z,
+            a.m[0][1] * v.x + a.m[1][1] * v.y + a.m[2][1] * v.z,
+            a.m[0][2] * v.x + a.m[1][2] * v.y + a.m[2][2] * v.z};
+}
+
 /// Rotation by angle_rad about a unit axis (Rodrigues' formula).
 inline Mat3 rotation_about_axis(const Vec3& unit_axis, double angle_rad)
 {

@@ -1141,22 +1141,30 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
     // face whose interior holds its closest point holds the hull's. So one contact per body at most, from the
     // faces the centre faces. A centre behind every face within reach is inside the body: it is pushed out
     // through the nearest face plane (an overlap beyond the radius, which the overlap limit stops).
-    const MeshWall* mw = nullptr;
-    std::uint32_t body_mesh = kPlaneCandidate;
-    double slack = 0.0;
+    //
+    // The pairs stream in order, but each meets its body's frame and its own contact record (read for its
+    // history, written when touching) out of the order the hardware prefetches: both are fetched a few pairs
+    // ahead, with the faces (on a bed of 20,000 spheres and 1,000 rocks the sphere-body phase took 13 % less
+    // time, docs/BENCHMARKS.md).
+    constexpr std::size_t kAhead = 8;
+    auto prefetch = [](const void* at, std::size_t bytes) {
+        for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(static_cast<const char*>(at) + line);
+    };
     std::size_t touching = 0;
     for (std::size_t k = begin; k < end; ++k) {
         const ConvexPair pair = convex_pairs_[k];
-        if (pair.mesh != body_mesh) {
-            body_mesh = pair.mesh;
-            mw = &meshes_[pair.mesh];
-            slack = mw->convex_slack_m();
+        if (k + kAhead < end) {
+            const ConvexPair& next = convex_pairs_[k + kAhead];
+            prefetch(&convex_frames_[next.mesh], sizeof(ConvexFrame));
+            prefetch(&convex_contacts_[k + kAhead], sizeof(WallContact));
+            prefetch(&convex_faces_[next.face_begin], (next.face_end - next.face_begin) * sizeof(PackedTriangle));
         }
+        const ConvexFrame& frame = convex_frames_[pair.mesh];
         const std::uint32_t i = pair.particle;
         const Vec3 x = particles_.position_m[i];
         const double r = particles_.radius_m[i];
-        const Vec3 xb = mw->to_body(x);
-        const double clear = r + slack;
+        const Vec3 xb = frame.to_body * (x - frame.translation_m);
+        const double clear = r + frame.slack_m;
         double farthest = -std::numeric_limits<double>::infinity();
         std::uint32_t farthest_f = pair.face_begin;
         bool separated = false;
@@ -1218,17 +1226,17 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         if (c.first_step) c.history = ContactHistory{};
         convex_touching_[k] = 1;
         c.particle = i;
-        c.wall = mesh_wall_id_[pair.mesh];
+        c.wall = frame.wall;
         c.triangle = convex_face_triangle_[face];
-        c.normal = mw->rotation() * normal_b;
-        c.point = mw->to_world(point_b);
+        c.normal = transposed_times(frame.to_body, normal_b);
+        c.point = transposed_times(frame.to_body, point_b) + frame.translation_m;
         c.overlap_m = overlap;
         const Vec3 v = particles_.velocity_m_per_s[i];
         const Vec3 w = particles_.angular_velocity_rad_per_s[i];
         // the constants of the law (eq. 4, 6, 8) of this sphere's kind against this body
         const MaterialIndex mat = particles_.material[i];
         const double m = particles_.mass_kg[i];
-        const WallMotion& motion = wall_motion_[static_cast<std::size_t>(c.wall)];
+        const WallMotion& motion = frame.motion;
         const PairCoefficients& p = materials_.pair_unchecked(mat, motion.material);
         const ContactConstants constants =
             contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
@@ -1290,6 +1298,13 @@ void World::compute_wall_contacts(double dt_s)
         } else {
             wall_motion_[w] = {Vec3{}, Vec3{}, Vec3{}, 0.0, planes_[static_cast<std::size_t>(ref.index)].material};
         }
+    }
+    convex_frames_.resize(meshes_.size());
+    for (std::size_t m = 0; m < meshes_.size(); ++m) {
+        const MeshWall& mw = meshes_[m];
+        if (!mw.convex()) continue;
+        const std::int32_t w = mesh_wall_id_[m];
+        convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), w, wall_motion_[static_cast<std::size_t>(w)]};
     }
     std::size_t convex_touching = 0;
     thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));

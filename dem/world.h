@@ -223,6 +223,16 @@ private:
     std::vector<MeshWall> meshes_;
     std::vector<WallRef> walls_;
     std::vector<WallMotion> wall_motion_;  ///< beside walls_, refreshed by compute_wall_contacts
+    /// What the sphere pairs of a convex body read of it, in four cache lines (the geometry in the first two):
+    /// the pairs meet their bodies in no order, so each is fetched ahead of its pair (compute_convex_contacts).
+    struct alignas(64) ConvexFrame {
+        Mat3 to_body;          ///< the transposed rotation
+        Vec3 translation_m;
+        double slack_m;
+        std::int32_t wall;
+        WallMotion motion;
+    };
+    std::vector<ConvexFrame> convex_frames_;  ///< beside meshes_ (convex ones only), refreshed by compute_wall_contacts
     std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
     std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
