@@ -105,6 +105,7 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
     }
     walls_.push_back({true, static_cast<int>(meshes_.size() - 1)});
     mesh_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
+    mesh_moved_.push_back(1);
     wall_force_N_.resize(walls_.size());
     wall_torque_N_m_.resize(walls_.size());
     rebuild_needed_ = true;
@@ -116,8 +117,9 @@ void World::set_mesh_pose(int wall_id, const Mat3& rotation, const Vec3& transla
                           const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s)
 {
     if (!is_mesh(wall_id)) throw InputError(concat("wall ", wall_id, " is not a mesh wall"));
-    meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index)].set_pose(
-        rotation, translation_m, reference_point_m, reference_velocity_m_per_s, angular_velocity_rad_per_s);
+    const auto m = static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index);
+    meshes_[m].set_pose(rotation, translation_m, reference_point_m, reference_velocity_m_per_s, angular_velocity_rad_per_s);
+    mesh_moved_[m] = 1;
 }
 
 bool World::is_mesh(int wall_id) const
@@ -159,7 +161,9 @@ Vec3 World::wall_torque_N_m(int wall_id) const
 void World::set_wall_mass_kg(int wall_id, double mass_kg)
 {
     if (!is_mesh(wall_id)) throw InputError(concat("set_wall_mass_kg: wall '", wall_name(wall_id), "' is a plane, which is immovable"));
-    meshes_[static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index)].set_mass_kg(mass_kg);
+    const auto m = static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index);
+    meshes_[m].set_mass_kg(mass_kg);
+    mesh_moved_[m] = 1;
 }
 
 void World::sum_wall_reactions()
@@ -343,8 +347,10 @@ double World::kick_and_drift(double dt_s)
 
 void World::move_prescribed_meshes(double t_end_s, double dt_s)
 {
-    for (MeshWall& m : meshes_) {
+    for (std::size_t q = 0; q < meshes_.size(); ++q) {
+        MeshWall& m = meshes_[q];
         if (!m.motion()) continue;
+        mesh_moved_[q] = 1;
         const PrescribedMotion& motion = *m.motion();
         Mat3 r;
         Vec3 t;
@@ -774,6 +780,9 @@ void World::split_candidates()
         }
         wall_candidate_start_[i + 1] = static_cast<std::uint32_t>(wall_candidates_.size());
     }
+    wall_particles_.clear();
+    for (std::size_t i = 0; i < n; ++i)
+        if (wall_candidate_start_[i + 1] > wall_candidate_start_[i]) wall_particles_.push_back(static_cast<std::uint32_t>(i));
     candidate_triangles_.resize(wall_candidates_.size());
     candidate_ids_.resize(wall_candidates_.size());
     for (std::size_t k = 0; k < wall_candidates_.size(); ++k)
@@ -1288,23 +1297,19 @@ void World::compute_wall_contacts(double dt_s)
 {
     const std::size_t n = particles_.size();
     const bool any_wall = !walls_.empty();
+    // the small records of the walls, for the meshes moved (or changed in mass) since the last wall phase
     wall_motion_.resize(walls_.size());
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-        const WallRef& ref = walls_[w];
-        if (ref.is_mesh) {
-            const MeshWall& mw = meshes_[static_cast<std::size_t>(ref.index)];
-            wall_motion_[w] = {mw.reference_point_m(), mw.reference_velocity_m_per_s(), mw.angular_velocity_rad_per_s(), mw.mass_kg(),
-                               mw.material()};
-        } else {
-            wall_motion_[w] = {Vec3{}, Vec3{}, Vec3{}, 0.0, planes_[static_cast<std::size_t>(ref.index)].material};
-        }
-    }
+    for (std::size_t q = 0; q < planes_.size(); ++q)
+        wall_motion_[static_cast<std::size_t>(plane_wall_id_[q])] = {Vec3{}, Vec3{}, Vec3{}, 0.0, planes_[q].material};
     convex_frames_.resize(meshes_.size());
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
+        if (!mesh_moved_[m]) continue;
+        mesh_moved_[m] = 0;
         const MeshWall& mw = meshes_[m];
-        if (!mw.convex()) continue;
-        const std::int32_t w = mesh_wall_id_[m];
-        convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), w, wall_motion_[static_cast<std::size_t>(w)]};
+        const auto w = static_cast<std::size_t>(mesh_wall_id_[m]);
+        wall_motion_[w] = {mw.reference_point_m(), mw.reference_velocity_m_per_s(), mw.angular_velocity_rad_per_s(), mw.mass_kg(), mw.material()};
+        if (mw.convex())
+            convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), mesh_wall_id_[m], wall_motion_[w]};
     }
     std::size_t convex_touching = 0;
     thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));
@@ -1331,8 +1336,11 @@ void World::compute_wall_contacts(double dt_s)
         std::vector<WallContact> out = std::move(thread_wall_contacts_[static_cast<std::size_t>(t)]);
         std::vector<WallHit> hits = std::move(thread_wall_hits_[static_cast<std::size_t>(t)]);
         out.clear();
-        if (any_wall)
-            for (std::size_t i = begin; i < end; ++i) find_wall_contacts(static_cast<std::uint32_t>(i), dt_s, hits, out);
+        if (any_wall) {  // only the thread's particles with a plane or an open mesh within reach can touch one
+            const auto first = std::lower_bound(wall_particles_.begin(), wall_particles_.end(), begin);
+            const auto last = std::lower_bound(first, wall_particles_.end(), end);
+            for (auto i = first; i != last; ++i) find_wall_contacts(*i, dt_s, hits, out);
+        }
         // the spheres near convex bodies, in particle order: each pair's contact in its place
         const std::size_t pair_begin = convex_thread_start_[static_cast<std::size_t>(t)];
         const std::size_t pair_end = convex_thread_start_[static_cast<std::size_t>(t) + 1];
@@ -1361,10 +1369,13 @@ void World::compute_wall_contacts(double dt_s)
         std::size_t k = wall_contact_offset_[static_cast<std::size_t>(t)];
         const auto& filled = threads_ == 1 ? wall_contacts_ : thread_wall_contacts_[static_cast<std::size_t>(t)];
         if (threads_ > 1) std::copy(filled.begin(), filled.end(), wall_contacts_.begin() + static_cast<std::ptrdiff_t>(k));
-        for (std::size_t i = begin; i < end; ++i) {
-            wall_contact_start_[i] = static_cast<std::uint32_t>(k);
-            while (k < wall_contact_offset_[static_cast<std::size_t>(t) + 1] && wall_contacts_[k].particle == i) ++k;
-        }
+        // each particle's first contact: the contacts are in particle order, and a particle without one starts
+        // where the next contact is
+        const std::size_t k_end = wall_contact_offset_[static_cast<std::size_t>(t) + 1];
+        std::size_t i = begin;
+        for (; k < k_end; ++k)
+            for (const std::size_t p = wall_contacts_[k].particle; i <= p; ++i) wall_contact_start_[i] = static_cast<std::uint32_t>(k);
+        for (; i < end; ++i) wall_contact_start_[i] = static_cast<std::uint32_t>(k_end);
 
         // the reaction of the planes and open meshes, in list order, and the thread's first contact past the
         // overlap limit
@@ -1652,6 +1663,7 @@ void World::read_state(StateReader& in)
         m.restore_pose(rotation, translation, reference, velocity, spin, version);
         m.set_mass_kg(in.value<double>());
     }
+    std::fill(mesh_moved_.begin(), mesh_moved_.end(), 1);
     in.tag("neighbours");
     in.array(pair_i_);
     in.array(pair_j_);

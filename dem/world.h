@@ -234,6 +234,7 @@ private:
     };
     std::vector<ConvexFrame> convex_frames_;  ///< beside meshes_ (convex ones only), refreshed by compute_wall_contacts
     std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
+    std::vector<std::uint8_t> mesh_moved_;    ///< beside meshes_: posed or given a mass since the last wall phase
     std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
@@ -270,6 +271,7 @@ private:
     // the planes and the triangles of open meshes, per particle (candidates_ less the convex bodies)
     std::vector<std::uint32_t> wall_candidate_start_;
     std::vector<MeshCandidate> wall_candidates_;
+    std::vector<std::uint32_t> wall_particles_;       ///< the particles with a wall candidate, in order
     std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside wall_candidates_ (planes: unused)
     std::vector<TriangleIds> candidate_ids_;           ///< beside wall_candidates_, read only for touched triangles
     /// A sphere within reach of a convex body (a rock's hull): at most one contact (find the reason at
