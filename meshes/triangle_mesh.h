@@ -25,6 +25,9 @@ struct ClosestPoint {
 /// Exact closest point on triangle (a, b, c) to p, by Voronoi regions of the vertices, edges and face
 /// (Ericson, Real-Time Collision Detection (2005), §5.1.5). Inline: the sphere-wall search calls it in its
 /// inner loop.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
 inline ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
 {
     ClosestPoint out;
