@@ -715,6 +715,14 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     split_candidates();
 }
 
+namespace {
+
+bool has_vertex(const PackedTriangle& t, const Vec3& v) { return t.a == v || t.b == v || t.c == v; }
+/// The end points of edge k of a triangle, in the numbering of meshes::ClosestPoint (ab, bc, ca).
+std::pair<Vec3, Vec3> edge_ends(const PackedTriangle& t, int k) { return k == 0 ? std::pair{t.a, t.b} : k == 1 ? std::pair{t.b, t.c} : std::pair{t.c, t.a}; }
+
+}  // namespace
+
 void World::split_candidates()
 {
     // Planes and open meshes stay with their particle; a convex body's triangles become one pair of the sphere
@@ -757,6 +765,25 @@ void World::split_candidates()
         p.face_end = at + (p.face_end - p.face_begin);
         p.face_begin = at;
     }
+    convex_face_across_.resize(convex_faces_.size());
+    for (const ConvexPair& p : convex_pairs_)
+        for (std::uint32_t f = p.face_begin; f < p.face_end; ++f)
+            for (int k = 0; k < 3; ++k) {
+                const auto [e0, e1] = edge_ends(convex_faces_[f], k);
+                FaceAcross& across = convex_face_across_[f];
+                across.face[k] = kNoFace;
+                across.edge[k] = 0;
+                for (std::uint32_t g = p.face_begin; g < p.face_end; ++g) {
+                    const PackedTriangle& gt = convex_faces_[g];
+                    if (g == f || !has_vertex(gt, e0) || !has_vertex(gt, e1)) continue;
+                    across.face[k] = g;
+                    for (int j = 0; j < 3; ++j) {  // the edge of g with both ends (g is not degenerate: one)
+                        const auto [g0, g1] = edge_ends(gt, j);
+                        if ((g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0)) across.edge[k] = static_cast<std::uint8_t>(j);
+                    }
+                    break;
+                }
+            }
     // a pair's contact is read only while it touches, so the contacts need no clearing
     convex_contacts_.resize(convex_pairs_.size());
     convex_touching_.assign(convex_pairs_.size(), 0);
@@ -1103,15 +1130,7 @@ void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const V
     c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
 }
 
-namespace {
-
-bool has_vertex(const PackedTriangle& t, const Vec3& v) { return t.a == v || t.b == v || t.c == v; }
-/// The end points of edge k of a triangle, in the numbering of meshes::ClosestPoint (ab, bc, ca).
-std::pair<Vec3, Vec3> edge_ends(const PackedTriangle& t, int k) { return k == 0 ? std::pair{t.a, t.b} : k == 1 ? std::pair{t.b, t.c} : std::pair{t.c, t.a}; }
-
-}  // namespace
-
-bool World::edge_point_is_closest(const ConvexPair& pair, std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
+bool World::edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
                                   std::uint32_t& best_face) const
 {
     // The closest point q of face F lies on its edge E. In a closed convex mesh E has one more face, G; q is the
@@ -1119,26 +1138,21 @@ bool World::edge_point_is_closest(const ConvexPair& pair, std::uint32_t face_f, 
     // G's plane (then it lies in that cone by F's own condition). A point of G's interior, or of E computed from
     // G and closer by round-off, is taken instead, as the search over all faces would take it. Anything else,
     // or G not among the pair's faces, leaves the answer to that search (returns false, `best` as it came).
-    const auto [e0, e1] = edge_ends(convex_faces_[face_f], best.local_index);
-    for (std::uint32_t g = pair.face_begin; g < pair.face_end; ++g) {
-        const PackedTriangle& gt = convex_faces_[g];
-        if (g == face_f || !has_vertex(gt, e0) || !has_vertex(gt, e1)) continue;
-        const double d = dot(xb - gt.a, gt.normal);
-        if (d <= 0.0 || d * d >= best.distance_squared) return true;
-        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, gt.a, gt.b, gt.c);
-        bool on_e = cp.feature == meshes::Feature::Face;
-        if (cp.feature == meshes::Feature::Edge) {
-            const auto [g0, g1] = edge_ends(gt, cp.local_index);
-            on_e = (g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0);
-        }
-        if (!on_e && cp.distance_squared < best.distance_squared) return false;
-        if (cp.distance_squared < best.distance_squared) {
-            best = cp;
-            best_face = g;
-        }
-        return true;
+    const FaceAcross& across = convex_face_across_[face_f];
+    const std::uint32_t g = across.face[best.local_index];
+    if (g == kNoFace) return false;
+    const PackedTriangle& gt = convex_faces_[g];
+    const double d = dot(xb - gt.a, gt.normal);
+    if (d <= 0.0 || d * d >= best.distance_squared) return true;
+    const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, gt.a, gt.b, gt.c);
+    const bool on_e = cp.feature == meshes::Feature::Face ||
+                      (cp.feature == meshes::Feature::Edge && cp.local_index == across.edge[best.local_index]);
+    if (!on_e && cp.distance_squared < best.distance_squared) return false;
+    if (cp.distance_squared < best.distance_squared) {
+        best = cp;
+        best_face = g;
     }
-    return false;
+    return true;
 }
 
 std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, Vec3* __restrict wall_force,
@@ -1167,6 +1181,7 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
             prefetch(&convex_frames_[next.mesh], sizeof(ConvexFrame));
             prefetch(&convex_contacts_[k + kAhead], sizeof(WallContact));
             prefetch(&convex_faces_[next.face_begin], (next.face_end - next.face_begin) * sizeof(PackedTriangle));
+            prefetch(&convex_face_across_[next.face_begin], (next.face_end - next.face_begin) * sizeof(FaceAcross));
         }
         const ConvexFrame& frame = convex_frames_[pair.mesh];
         const std::uint32_t i = pair.particle;
@@ -1194,7 +1209,7 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
             // face lies inside it, this is that face, and one query settles the body
             const PackedTriangle& ft = convex_faces_[farthest_f];
             meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
-            if (best_cp.feature == meshes::Feature::Edge && edge_point_is_closest(pair, farthest_f, xb, best_cp, face)) {
+            if (best_cp.feature == meshes::Feature::Edge && edge_point_is_closest(farthest_f, xb, best_cp, face)) {
                 // settled by the face across the edge (most closest points off a face lie on an edge)
             } else if (best_cp.feature != meshes::Feature::Face) {
                 for (std::uint32_t f = pair.face_begin; f < pair.face_end; ++f) {

@@ -280,11 +280,16 @@ private:
     struct ConvexPair { std::uint32_t mesh, particle, face_begin, face_end; };
     /// Whether `best`, the closest point of face face_f of a convex pair on one of its edges, is the body's:
     /// decided from the face across that edge, which may replace it (`best`, `best_face`).
-    bool edge_point_is_closest(const ConvexPair& pair, std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
+    bool edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
                                std::uint32_t& best_face) const;
     std::vector<ConvexPair> convex_pairs_;
     std::vector<PackedTriangle> convex_faces_;       ///< body frame, the faces within reach of each pair in turn
     std::vector<std::int32_t> convex_face_triangle_; ///< beside convex_faces_: the mesh's triangle
+    /// The face across each edge (ab, bc, ca) of a pair's face among the pair's faces (the first in order that
+    /// shares both ends, kNoFace if none), and which edge of it that is; found at each rebuild.
+    struct FaceAcross { std::uint32_t face[3]; std::uint8_t edge[3]; };
+    static constexpr std::uint32_t kNoFace = 0xffffffffu;
+    std::vector<FaceAcross> convex_face_across_;     ///< beside convex_faces_
     std::vector<WallContact> convex_contacts_;       ///< beside convex_pairs_: the contact of this step, if touching
     std::vector<std::uint8_t> convex_touching_;      ///< beside convex_pairs_
     struct Push { Vec3 force_N, torque_N_m; };       ///< on the particle, about its centre
