@@ -1335,6 +1335,7 @@ void World::compute_wall_contacts(double dt_s)
     }
     thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
+    thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
         const int t = omp_get_thread_num();
@@ -1360,7 +1361,9 @@ void World::compute_wall_contacts(double dt_s)
         const std::size_t pair_begin = convex_thread_start_[static_cast<std::size_t>(t)];
         const std::size_t pair_end = convex_thread_start_[static_cast<std::size_t>(t) + 1];
         std::size_t first_deep_convex = kNoContact;
+        auto convex_start = std::chrono::steady_clock::now();
         convex_touching += compute_convex_contacts(pair_begin, pair_end, dt_s, wall_force, wall_torque, first_deep_convex);
+        thread_convex_seconds_[static_cast<std::size_t>(t)] = seconds_since(convex_start);
         thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
 
         // Last step's contacts have been read (their history): each thread's contacts, in particle order,
@@ -1408,6 +1411,7 @@ void World::compute_wall_contacts(double dt_s)
         thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
     }
     convex_contact_count_ = convex_touching;
+    phase_seconds_.convex_forces += *std::max_element(thread_convex_seconds_.begin(), thread_convex_seconds_.end());
     records_stale_ = true;
 }
 

@@ -42,6 +42,7 @@ struct PhaseSeconds {
     double neighbour_search = 0.0;  ///< neighbour-list and wall-candidate rebuilds
     double pair_forces = 0.0;       ///< sphere-sphere contacts
     double wall_forces = 0.0;       ///< sphere-wall contacts: planes, meshes and coupled rigid bodies
+    double convex_forces = 0.0;     ///< of wall_forces: the spheres' pairs with convex bodies (rocks), slowest thread
     double integration = 0.0;       ///< kicks, drift, force gathering, wall reactions and records
 };
 
@@ -298,6 +299,7 @@ private:
     std::vector<std::size_t> convex_thread_start_;   ///< the pairs of each thread (those of its particles)
     std::size_t convex_contact_count_ = 0;
     std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit
+    std::vector<double> thread_convex_seconds_;           ///< per thread: its pass over its convex pairs, this step
     /// The wall-candidate search's large working lists, kept for their capacity.
     struct CandidateScratch {
         std::vector<std::pair<std::uint32_t, MeshCandidate>> entries;  ///< (cell, triangle)
