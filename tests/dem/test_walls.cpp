@@ -255,6 +255,55 @@ TEST_CASE("a mesh moved from outside is seen by the neighbour lists", "[dem][wal
     CHECK(w.particles().velocity_m_per_s[0].x == Approx(-2.0).epsilon(1e-3));
 }
 
+TEST_CASE("a convex body moved or given a mass from outside is seen by its sphere contacts in the next step",
+          "[dem][walls][unit]")
+{
+    // The wall phase keeps a small record of each body's pose and motion, refreshed when the body is moved or
+    // given a mass. A sphere rests on a 1 m box (no gravity, no friction); after the first step the box is
+    // raised 20 um and given an upward speed, then a mass, between steps. Each step's contact must be that of
+    // the box where it is now: the overlap r minus the centre's distance to the moved surface, and the normal
+    // force of eq. 3 and 6 with the relative speed the record reports and the effective mass m M / (m + M).
+    // A stale pose would be 20 um off; a stale mass changes the damping term by a factor of 30.
+    WorldSettings settings;
+    settings.gravity_m_per_s2 = {};
+    settings.step_s = 1e-6;
+    const PairCoefficients pair = test::coefficients(0.0, 0.0, 0.5, 0.5, 0.05, 0.27);
+    const MaterialTable table = test::two_material_table(pair, 3700.0, 45e9, 0.3);
+    World w(table, settings);
+    const meshes::TriangleMesh box = meshes::make_box_mesh({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+    const int id = w.add_mesh(box, 1, "box");
+    const double r = 0.05;
+    w.add_particle({{0.1, 0.2, 0.5 + r - 1e-4}, {}, {}, r, 0});
+    const double m = w.particles().mass_kg[0];
+    const double kn = wall_normal_stiffness(table.material(0).bulk_modulus_Pa(), r, pair.normal_stiffness_scale);
+
+    auto check_contact = [&](const Vec3& box_centre, double body_mass_kg) {
+        const auto& records = w.last_contact_records();
+        REQUIRE(records.size() == 1);
+        const ContactRecord& c = records[0];
+        const Vec3 x = w.particles().position_m[0];
+        CHECK(c.overlap_m == Approx(r - box.distance_m(x - box_centre)).margin(1e-13));
+        const double vn = dot(c.relative_displacement_m, c.normal_world) / w.step_s();
+        const double effective = body_mass_kg > 0.0 ? m * body_mass_kg / (m + body_mass_kg) : m;
+        const double damping = pair.normal_damping_ratio * 2.0 * std::sqrt(effective * kn);
+        CHECK(c.normal_force_N == Approx(kn * c.overlap_m - damping * vn).epsilon(1e-10));
+        return damping * std::abs(vn);
+    };
+    w.step();
+    check_contact({}, 0.0);
+
+    const Vec3 raised{0.0, 0.0, 2e-5};
+    w.set_mesh_pose(id, Mat3::identity(), raised, raised, {0.0, 0.0, 0.05}, {});
+    w.step();
+    const double damping_immovable = check_contact(raised, 0.0);
+    CHECK(damping_immovable > 1e-3 * kn * 1e-4);  // the damping term is there to be seen
+
+    w.set_wall_mass_kg(id, m / 1000.0);
+    w.step();
+    const double damping_light = check_contact(raised, m / 1000.0);
+    CHECK(damping_light < 0.1 * damping_immovable);
+}
+
 TEST_CASE("spheres around a convex mesh touch it exactly where their centre is within a radius of its surface",
           "[dem][walls][unit]")
 {
