@@ -200,7 +200,7 @@ int main(int argc, char** argv)
         std::size_t body_contacts = 0;
         for (const ContactRecord& r : bed.dem.last_contact_records())
             if (bed.dem.is_mesh(r.surface_id)) ++body_contacts;
-        std::printf("| %s | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.2f | %zu | %zu | %016llx |\n", name.c_str(), wall * per,
+        std::printf("| %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | %zu | %zu | %016llx |\n", name.c_str(), wall * per,
                     (p.pair_forces - p0.pair_forces) * per, (p.wall_forces - p0.wall_forces) * per,
                     (p.convex_forces - p0.convex_forces) * per, (p.neighbour_search - p0.neighbour_search) * per,
                     (p.integration - p0.integration) * per, (bed.world.rigid_seconds() - r0) * per,
