@@ -287,7 +287,8 @@ private:
     std::vector<PackedTriangle> convex_faces_;       ///< body frame, the faces within reach of each pair in turn
     std::vector<std::int32_t> convex_face_triangle_; ///< beside convex_faces_: the mesh's triangle
     /// The face across each edge (ab, bc, ca) of a pair's face among the pair's faces (the first in order that
-    /// shares both ends, kNoFace if none), and which edge of it that is; found at each rebuild.
+    /// shares both ends, kNoFace if none), and which edge of it that is; found at each rebuild by comparing
+    /// every two faces of a pair (a pair holds the few faces within reach of one sphere).
     struct FaceAcross { std::uint32_t face[3]; std::uint8_t edge[3]; };
     static constexpr std::uint32_t kNoFace = 0xffffffffu;
     std::vector<FaceAcross> convex_face_across_;     ///< beside convex_faces_
