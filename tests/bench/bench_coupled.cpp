@@ -3,8 +3,13 @@
 // Spheres 200 mm; rocks of Table 1's classes in Table 1's mass ratios among themselves; Aitik ore (Table 2).
 // Usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]
 //                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]
+//                             [--turn N]
 // The bed is filled loosely in a box, settled for --settle-s at n = 10 and saved to --cache (a later run loads
 // it); each variant then starts from that state, takes 200 DEM steps to warm up, and times --steps DEM steps.
+// --turn N: the variants take turns of N DEM steps each (all their beds in memory) until each has done --steps;
+// each coupled turn is then also divided by the DEM alone's turn just before it. The two met the same state of a
+// machine whose speed drifts by tens of per cent within minutes, so the median of those ratios is the steadier
+// figure. Without --turn each variant runs its --steps in one go.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
 // Each variant ends with the spheres' state hash (the one summary.json gives): a change that should not move
 // results must keep it.
@@ -17,6 +22,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -77,13 +83,14 @@ double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_cloc
 
 int main(int argc, char** argv)
 {
-    int spheres = 20000, rocks = 1000, threads = 1, steps = 400;
+    int spheres = 20000, rocks = 1000, threads = 1, steps = 400, turn = 0;
     double dt = 5e-5, settle_s = 0.6;
     std::string cache, substeps_list = "1,5,10,20";
     std::string pairs = "dipper", guard = "off";
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
-        "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n";
+        "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n"
+        "                            [--turn N]\n";
     const int status = bench::read_options(argc, argv, usage, [&](const std::string& key, const char* value) {
         if (key == "--spheres") spheres = std::atoi(value);
         else if (key == "--rocks") rocks = std::atoi(value);
@@ -95,6 +102,7 @@ int main(int argc, char** argv)
         else if (key == "--cache") cache = value;
         else if (key == "--pairs") pairs = value;
         else if (key == "--runaway-guard") guard = value;
+        else if (key == "--turn") turn = std::atoi(value);
         else return false;
         return true;
     });
@@ -151,64 +159,100 @@ int main(int argc, char** argv)
         coupling::save_state(bed.world, cache);
     }
 
-    std::printf("\nbed from %s, dt = %g s, %d thread(s), %d timed DEM steps; seconds of wall time per simulated second:\n",
-                cache.c_str(), dt, threads, steps);
-    std::printf("| variant | total | sphere-sphere | sphere-body and walls | of it sphere-rock | neighbour search | integration | "
-                "Bullet | surface motion | x DEM-only | sphere-sphere contacts | sphere-body contacts | state hash |\n");
-    std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
-    double dem_only_total = 0.0;
+    // every variant's bed, loaded from the cache and warmed up; then they take turns of --turn DEM steps each
+    // until each has timed --steps (one turn by default: each variant in one go, as before)
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
-    for (int n : variants) {
-        Bed bed(dt, threads, std::max(n, 1), bullet_pairs, guard == "on");
-        bed.add_box(side, height + 1.0);
-        coupling::load_state(bed.world, cache);
-        const int warm = 200;
-        auto run = [&](int dem_steps) {
-            if (n == 0)
-                bed.dem.run_steps(static_cast<std::uint64_t>(dem_steps));
-            else
-                for (int k = 0; k < dem_steps / n; ++k) bed.world.step();
-        };
-        const std::string name = n == 0 ? "DEM only" : "n = " + std::to_string(n);
-        auto guard_line = [&] {
-            if (guard == "on" && n > 1)
-                std::printf("  %s: runaway guard set off %llu times, %llu coupling steps guarded\n", name.c_str(),
-                            static_cast<unsigned long long>(bed.world.runaways_caught()),
-                            static_cast<unsigned long long>(bed.world.guarded_steps()));
-        };
+    if (turn <= 0) turn = steps;
+    for (int n : variants)
+        if (n < 0 || (n > 0 && turn % n != 0) || steps % turn != 0) {
+            std::fprintf(stderr, "--turn %d: expected a divisor of --steps %d and a multiple of every --substeps value (%d is not)\n",
+                         turn, steps, n);
+            return 2;
+        }
+    struct Run {
+        int n;
+        std::string name;
+        std::unique_ptr<Bed> bed;
         dem::PhaseSeconds p0;
         double r0 = 0.0, s0 = 0.0, sim0 = 0.0, wall = 0.0;
+        std::vector<double> turn_s;  ///< wall time of each turn
+        std::string failed;          ///< the error that stopped it
+    };
+    std::vector<Run> runs;
+    for (int n : variants) {
+        Run r;
+        r.n = n;
+        r.name = n == 0 ? "DEM only" : "n = " + std::to_string(n);
+        r.bed = std::make_unique<Bed>(dt, threads, std::max(n, 1), bullet_pairs, guard == "on");
+        r.bed->add_box(side, height + 1.0);
+        coupling::load_state(r.bed->world, cache);
+        runs.push_back(std::move(r));
+    }
+    auto advance = [](Run& r, int dem_steps) {
+        if (!r.failed.empty()) return;
         try {
-            run(warm);
-            p0 = bed.dem.phase_seconds();
-            r0 = bed.world.rigid_seconds();
-            s0 = bed.world.surface_seconds();
-            sim0 = bed.dem.time_s();
-            const auto t0 = std::chrono::steady_clock::now();
-            run(steps);
-            wall = seconds(t0, std::chrono::steady_clock::now());
+            if (r.n == 0)
+                r.bed->dem.run_steps(static_cast<std::uint64_t>(dem_steps));
+            else
+                for (int k = 0; k < dem_steps / r.n; ++k) r.bed->world.step();
         } catch (const SimulationError& e) {
-            std::printf("| %s | stopped at step %llu: %s |\n", name.c_str(), static_cast<unsigned long long>(bed.dem.step_count()), e.what());
-            guard_line();
-            std::fflush(stdout);
+            r.failed = concat("stopped at step ", r.bed->dem.step_count(), ": ", e.what());
+        }
+    };
+    for (Run& r : runs) {
+        advance(r, 200);  // warm-up
+        r.p0 = r.bed->dem.phase_seconds();
+        r.r0 = r.bed->world.rigid_seconds();
+        r.s0 = r.bed->world.surface_seconds();
+        r.sim0 = r.bed->dem.time_s();
+    }
+    for (int done = 0; done < steps; done += turn)
+        for (Run& r : runs) {
+            const auto t0 = std::chrono::steady_clock::now();
+            advance(r, turn);
+            const double s = seconds(t0, std::chrono::steady_clock::now());
+            r.wall += s;
+            r.turn_s.push_back(s);
+        }
+
+    std::printf("\nbed from %s, dt = %g s, %d thread(s), %d timed DEM steps in turns of %d; seconds of wall time per simulated second:\n",
+                cache.c_str(), dt, threads, steps, turn);
+    std::printf("| variant | total | sphere-sphere | sphere-body and walls | of it sphere-rock | neighbour search | integration | "
+                "Bullet | surface motion | x DEM-only | x DEM-only, median turn (range) | sphere-sphere contacts | sphere-body contacts | state hash |\n");
+    std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+    const Run& alone = runs.front();
+    for (const Run& r : runs) {
+        if (!r.failed.empty()) {
+            std::printf("| %s | %s |\n", r.name.c_str(), r.failed.c_str());
             continue;
         }
-        const double sim = bed.dem.time_s() - sim0;
+        const Bed& bed = *r.bed;
+        const double per = 1.0 / (bed.dem.time_s() - r.sim0);
         const dem::PhaseSeconds& p = bed.dem.phase_seconds();
-        const double per = 1.0 / sim;
-        if (n == 0) dem_only_total = wall * per;
+        // each turn against the DEM alone's turn just before it: the two met the same state of the machine
+        std::vector<double> ratios;
+        if (alone.failed.empty())
+            for (std::size_t k = 0; k < r.turn_s.size(); ++k) ratios.push_back(r.turn_s[k] / alone.turn_s[k]);
+        std::sort(ratios.begin(), ratios.end());
+        char turns[64] = "-";
+        if (!ratios.empty())
+            std::snprintf(turns, sizeof turns, "%.2f (%.2f-%.2f)", 0.5 * (ratios[(ratios.size() - 1) / 2] + ratios[ratios.size() / 2]),
+                          ratios.front(), ratios.back());
         std::size_t body_contacts = 0;
-        for (const ContactRecord& r : bed.dem.last_contact_records())
-            if (bed.dem.is_mesh(r.surface_id)) ++body_contacts;
-        std::printf("| %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | %zu | %zu | %016llx |\n", name.c_str(), wall * per,
-                    (p.pair_forces - p0.pair_forces) * per, (p.wall_forces - p0.wall_forces) * per,
-                    (p.convex_forces - p0.convex_forces) * per, (p.neighbour_search - p0.neighbour_search) * per,
-                    (p.integration - p0.integration) * per, (bed.world.rigid_seconds() - r0) * per,
-                    (bed.world.surface_seconds() - s0) * per, wall * per / dem_only_total, bed.dem.pair_contact_count(),
-                    body_contacts, static_cast<unsigned long long>(scenario::particle_state_hash(bed.dem)));
-        guard_line();
-        std::fflush(stdout);
+        for (const ContactRecord& c : bed.dem.last_contact_records())
+            if (bed.dem.is_mesh(c.surface_id)) ++body_contacts;
+        std::printf("| %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | %s | %zu | %zu | %016llx |\n", r.name.c_str(),
+                    r.wall * per, (p.pair_forces - r.p0.pair_forces) * per, (p.wall_forces - r.p0.wall_forces) * per,
+                    (p.convex_forces - r.p0.convex_forces) * per, (p.neighbour_search - r.p0.neighbour_search) * per,
+                    (p.integration - r.p0.integration) * per, (bed.world.rigid_seconds() - r.r0) * per,
+                    (bed.world.surface_seconds() - r.s0) * per, alone.failed.empty() ? r.wall / alone.wall : 0.0, turns,
+                    bed.dem.pair_contact_count(), body_contacts, static_cast<unsigned long long>(scenario::particle_state_hash(bed.dem)));
+        if (guard == "on" && r.n > 1)
+            std::printf("  %s: runaway guard set off %llu times, %llu coupling steps guarded\n", r.name.c_str(),
+                        static_cast<unsigned long long>(bed.world.runaways_caught()),
+                        static_cast<unsigned long long>(bed.world.guarded_steps()));
     }
+    std::fflush(stdout);
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     std::printf("peak memory %.0f MiB\n", u.ru_maxrss / 1024.0);
