@@ -418,7 +418,7 @@ void RigidWorld::read_state(StateReader& in)
             const btVector3 v = to_bt(in.value<Vec3>()), omega = to_bt(in.value<Vec3>());
             b->body->setWorldTransform(t);
             b->body->setInterpolationWorldTransform(t);
-            b->motion->setWorldTransform(t);
+            if (b->motion) b->motion->setWorldTransform(t);
             b->body->setLinearVelocity(v);
             b->body->setAngularVelocity(omega);
             b->body->setInterpolationLinearVelocity(v);

@@ -22,6 +22,8 @@ btCollisionObject* object(const btBroadphaseProxy* proxy) { return static_cast<b
 // it was last checked: the two bodies' odometers then, plus what was left of its gap. While O_a + O_b stays
 // below T (less a slack for round-off), the bodies cannot have closed the gap, and the pair's own gap
 // bound would say the same, so the pair is passed over unread. 0: no threshold.
+// A hull and a fixed plane or triangle mesh with an empty manifold keep -T the same way (the sign tells the two
+// kinds apart), with m what the hull must travel before Bullet's algorithm could add a point (note_surface_gap).
 static_assert(sizeof(void*) == sizeof(double), "a threshold is kept in a pointer's place");
 double threshold(const btBroadphasePair& pair)
 {
@@ -106,13 +108,15 @@ double Dispatcher::moved(const btBroadphasePair& pair) const
 
 bool Dispatcher::clear_by_odometers(const btBroadphasePair& pair) const
 {
-    const double t = threshold(pair);
-    if (!(t > 0.0)) return false;
+    const double stored = threshold(pair);
+    if (stored == 0.0) return false;
+    const bool hulls = stored > 0.0;
+    const double t = hulls ? stored : -stored;
     const auto u0 = static_cast<std::size_t>(pair.m_pProxy0->m_uniqueId), u1 = static_cast<std::size_t>(pair.m_pProxy1->m_uniqueId);
     const double sum = odometer_[u0] + odometer_[u1];
-    // The pair's own bound adds 1e-6 r per body and keeps the first rotation in single precision (within 2e-7
-    // in norm); the sums carry round-off of about 1e-16 per step. Twice the first, and 1e-8 of the sums.
-    const double slack = 2e-6 * (radius_[u0] + radius_[u1]) + 1e-8 * (sum + t) + 1e-12;
+    // A hull pair's own bound adds 1e-6 r per body and keeps the first rotation in single precision (within 2e-7
+    // in norm): twice that. The sums carry round-off of about 1e-16 per step: 1e-8 of them, for both kinds.
+    const double slack = (hulls ? 2e-6 * (radius_[u0] + radius_[u1]) : 0.0) + 1e-8 * (sum + t) + 1e-12;
     return sum + slack < t;
 }
 
@@ -120,6 +124,80 @@ void Dispatcher::note_gap(btBroadphasePair& pair) const
 {
     const double m = convex_pair_apart_margin(*pair.m_algorithm, *object(pair.m_pProxy0), *object(pair.m_pProxy1));
     set_threshold(pair, m > 0.0 ? moved(pair) + m : 0.0);
+}
+
+namespace {
+
+/// The least, over the triangles near [lo, hi], of how far apart a triangle's box and [lo, hi] are along the axis
+/// that separates them most (<= 0 for a box that overlaps); `nearest` starts at the farthest it looks.
+struct NearestTriangleBox : public btTriangleCallback {
+    NearestTriangleBox(const btVector3& l, const btVector3& h, double reach) : lo(l), hi(h), nearest(reach) {}
+    void processTriangle(btVector3* t, int, int) override
+    {
+        double apart = -std::numeric_limits<double>::infinity();
+        for (int k = 0; k < 3; ++k) {
+            const double t_lo = std::min({t[0][k], t[1][k], t[2][k]}), t_hi = std::max({t[0][k], t[1][k], t[2][k]});
+            apart = std::max({apart, t_lo - hi[k], lo[k] - t_hi});
+        }
+        nearest = std::min(nearest, apart);
+    }
+    btVector3 lo, hi;
+    double nearest;
+};
+
+}  // namespace
+
+void Dispatcher::note_surface_gap(btBroadphasePair& pair) const
+{
+    // A hull against a fixed plane or triangle mesh, just processed. While its manifold is empty, Bullet's
+    // algorithm adds a point only where the hull (with its margin) comes within the contact breaking distance of
+    // the surface: for a plane, when the hull's lowest point along the normal does; for a mesh, only if a
+    // triangle's box meets the hull's box grown by the triangles' margin and the breaking distance (the hull lies
+    // in its box). Any point of the hull, and so each corner of the box Bullet turns with it, moves no farther
+    // than the growth of its odometer; a fixed surface does not move. So the pair can be passed over while that
+    // growth stays below the gap measured now, and nothing is skipped that Bullet's algorithm would have added.
+    set_threshold(pair, 0.0);
+    const btCollisionObject* a = object(pair.m_pProxy0);
+    const btCollisionObject* b = object(pair.m_pProxy1);
+    const bool a_hull = is_hull(a->getCollisionShape()->getShapeType());
+    const btCollisionObject& hull = a_hull ? *a : *b;
+    const btCollisionObject& surface = a_hull ? *b : *a;
+    if (!surface.isStaticObject() || surface.isKinematicObject()) return;
+    thread_local btManifoldArray manifolds;
+    manifolds.resize(0);
+    pair.m_algorithm->getAllContactManifolds(manifolds);
+    if (manifolds.size() != 1 || manifolds[0]->getNumContacts() != 0) return;
+    const double breaking = manifolds[0]->getContactBreakingThreshold();
+    const auto& shape = *static_cast<const btConvexShape*>(hull.getCollisionShape());
+    const btTransform& th = hull.getWorldTransform();
+    const btTransform& ts = surface.getWorldTransform();
+    double gap = 0.0;
+    if (surface.getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE) {
+        const auto& plane = *static_cast<const btStaticPlaneShape*>(surface.getCollisionShape());
+        const btVector3 n = ts.getBasis() * plane.getPlaneNormal();
+        const btVector3 on_plane = ts * (plane.getPlaneNormal() * plane.getPlaneConstant());
+        const btVector3 lowest = th * shape.localGetSupportingVertex(-n * th.getBasis());
+        gap = n.dot(lowest - on_plane) - breaking;
+    } else {
+        const auto& mesh = *static_cast<const btConcaveShape*>(surface.getCollisionShape());
+        // the hull's own box in the mesh's frame, from its support points along the axes (Bullet's getAabb adds
+        // the margin twice: a looser box, re-checked more often)
+        const btTransform in_mesh = ts.inverse() * th;
+        btVector3 lo, hi;
+        for (int k = 0; k < 3; ++k) {
+            const btVector3 axis = in_mesh.getBasis().getRow(k);  // the mesh's axis k in the hull's frame
+            hi[k] = (in_mesh * shape.localGetSupportingVertex(axis))[k];
+            lo[k] = (in_mesh * shape.localGetSupportingVertex(-axis))[k];
+        }
+        const btScalar grow = mesh.getMargin() + breaking;
+        lo -= btVector3(grow, grow, grow);
+        hi += btVector3(grow, grow, grow);
+        const double reach = hull_motion_radius(shape);  // look as far as the hull's size
+        NearestTriangleBox nearest(lo, hi, reach);
+        mesh.processAllTriangles(&nearest, lo - btVector3(reach, reach, reach), hi + btVector3(reach, reach, reach));
+        gap = nearest.nearest;
+    }
+    if (gap > 0.0) set_threshold(pair, -(moved(pair) + gap));
 }
 
 void Dispatcher::clear_thresholds(btOverlappingPairCache* pairs)
@@ -149,7 +227,7 @@ void Dispatcher::dispatchAllCollisionPairs(btOverlappingPairCache* pairs, const 
         return;
     }
     update_odometers();
-    thresholds_set_ = dipper_pairs_;
+    thresholds_set_ = true;
     btBroadphasePairArray& list = pairs->getOverlappingPairArray();
     const int n = list.size();
     work_.resize(static_cast<std::size_t>(n));
@@ -173,6 +251,7 @@ void Dispatcher::dispatchAllCollisionPairs(btOverlappingPairCache* pairs, const 
         work = kind(pair);
         if (work == Work::done) {
             process(pair, info);
+            note_surface_gap(pair);
         } else if (work == Work::hulls) {
             work = Work::none;
             // a pair still apart by its own gap bound: a new threshold from what is left of the gap

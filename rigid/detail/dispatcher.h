@@ -52,6 +52,7 @@ private:
     double moved(const btBroadphasePair& pair) const;
     bool clear_by_odometers(const btBroadphasePair& pair) const;
     void note_gap(btBroadphasePair& pair) const;
+    void note_surface_gap(btBroadphasePair& pair) const;
     void clear_thresholds(btOverlappingPairCache* pairs);
 
     int threads_;

@@ -69,7 +69,7 @@ struct RigidWorld::Impl {
         std::vector<std::unique_ptr<btCollisionShape>> children;  // of a compound shape
         std::unique_ptr<meshes::TriangleLocator> locator;          // of the last wear mesh asked for
         const meshes::TriangleMesh* located_mesh = nullptr;
-        std::unique_ptr<btDefaultMotionState> motion;
+        std::unique_ptr<btDefaultMotionState> motion;  ///< of static and kinematic bodies only
         std::unique_ptr<btRigidBody> body;  ///< rocks, static and kinematic parts
         // a link of a multibody (the shovel's dipper and door) instead of a rigid body
         std::unique_ptr<btMultiBodyLinkCollider> link_collider;
@@ -162,8 +162,11 @@ struct RigidWorld::Impl {
 
     BodyId insert(std::unique_ptr<Body> b, double mass, const btVector3& inertia, const btTransform& pose)
     {
-        b->motion = std::make_unique<btDefaultMotionState>(pose);
+        // A kinematic body is moved through its motion state. A dynamic one has none: Bullet would write each
+        // step's interpolated pose into it for a renderer, and nothing here reads it (its pose is the body's).
+        if (mass == 0.0) b->motion = std::make_unique<btDefaultMotionState>(pose);
         btRigidBody::btRigidBodyConstructionInfo info(mass, b->motion.get(), b->shape.get(), inertia);
+        info.m_startWorldTransform = pose;
         info.m_friction = 0.5;  // replaced per pair in the contact callback
         b->body = std::make_unique<btRigidBody>(info);
         b->body->setActivationState(DISABLE_DEACTIVATION);  // a resting rock must still feel new loads
