@@ -7,6 +7,7 @@
 #include "rigid/rigid_world.h"
 #include "rigid/detail/convex_pair.h"
 #include "rigid/detail/dispatcher.h"
+#include "rigid/detail/dynamics_world.h"
 
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionDispatch/btInternalEdgeUtility.h>
@@ -119,7 +120,7 @@ struct RigidWorld::Impl {
     Dispatcher dispatcher{&config, settings.threads, !settings.bullet_convex_pairs};
     btDbvtBroadphase broadphase;
     btMultiBodyConstraintSolver solver;
-    btMultiBodyDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
+    DynamicsWorld world{&dispatcher, &broadphase, &solver, &config, settings.threads};
     std::unique_ptr<ShovelState, ShovelDeleter> shovel;
     std::vector<std::unique_ptr<Body>> bodies;
     MaterialPairs pairs;
