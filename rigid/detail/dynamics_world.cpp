@@ -1,5 +1,9 @@
 #include "rigid/detail/dynamics_world.h"
 
+#include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
+
+#include <algorithm>
+
 #include <omp.h>
 
 namespace dipper::rigid {
@@ -10,6 +14,120 @@ bool DynamicsWorld::parallel() const
     for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i)
         if (m_nonStaticRigidBodies[i]->getCcdSquareMotionThreshold() != 0) return false;
     return true;
+}
+
+bool DynamicsWorld::parallel_islands() const
+{
+    if (!parallel() || m_multiBodies.size() > 0 || m_constraints.size() > 0 || m_multiBodyConstraints.size() > 0) return false;
+    for (int i = 0; i < m_collisionObjects.size(); ++i)
+        if (m_collisionObjects[i]->isKinematicObject()) return false;
+    return true;
+}
+
+/// Collects the islands' bodies and manifolds in the order Bullet's island manager hands them out.
+struct DynamicsWorld::IslandCollector : public btSimulationIslandManager::IslandCallback {
+    explicit IslandCollector(DynamicsWorld& w) : world(w) {}
+    void processIsland(btCollisionObject** bodies, int body_count, btPersistentManifold** manifolds, int manifold_count, int) override
+    {
+        world.island_bodies_.insert(world.island_bodies_.end(), bodies, bodies + body_count);
+        world.island_manifolds_.insert(world.island_manifolds_.end(), manifolds, manifolds + manifold_count);
+    }
+    DynamicsWorld& world;
+};
+
+void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
+{
+    if (!parallel_islands()) {
+        btMultiBodyDynamicsWorld::solveConstraints(solverInfo);
+        return;
+    }
+    // Bullet's steps (btMultiBodyDynamicsWorld::solveConstraints) with the solving of the islands in between
+    // done here: first the external forces and the set-up of Bullet's own batch list, which stays empty; last
+    // its empty remainder, allSolved and the multibodies' velocities (none here).
+    solveExternalForces(solverInfo);
+    island_bodies_.clear();
+    island_manifolds_.clear();
+    IslandCollector collector(*this);
+    m_islandManager->buildAndProcessIslands(getCollisionWorld()->getDispatcher(), getCollisionWorld(), &collector);
+
+    // Groups of bodies that touch through contact points. Bullet's solver turns the points of a batch's
+    // manifolds into rows and sweeps them in order; a row reads and moves only the velocities of its two bodies
+    // (a fixed part has zero inverse mass and stays at rest), and a body's external forces are added on its own.
+    // So the rows of one group, swept in the same order without the others', give its bodies the same bits. The
+    // sweeps stop early only when no row changed at all (the residual threshold is 0), which then holds for
+    // every group. Each body without a contact point is a group of its own.
+    const int body_count = static_cast<int>(island_bodies_.size());
+    parent_.resize(static_cast<std::size_t>(body_count));
+    bool known = true;  // every body carries dipper's body id (else all of them form one group)
+    for (int k = 0; k < body_count; ++k) {
+        const int id = island_bodies_[static_cast<std::size_t>(k)]->getUserIndex2();
+        known = known && id >= 0;
+        if (!known) break;
+        if (static_cast<int>(local_.size()) <= id) local_.resize(static_cast<std::size_t>(id) + 1, -1);
+        local_[static_cast<std::size_t>(id)] = k;
+    }
+    for (int k = 0; k < body_count; ++k) parent_[static_cast<std::size_t>(k)] = known ? k : 0;
+    auto root = [&](int k) {
+        while (parent_[static_cast<std::size_t>(k)] != k) k = parent_[static_cast<std::size_t>(k)] = parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(k)])];
+        return k;
+    };
+    auto place = [&](const btCollisionObject* o) {
+        if (o->isStaticOrKinematicObject()) return -1;
+        return known ? local_[static_cast<std::size_t>(o->getUserIndex2())] : 0;
+    };
+    for (const btPersistentManifold* m : island_manifolds_) {
+        if (m->getNumContacts() == 0) continue;
+        const int a = place(m->getBody0()), b = place(m->getBody1());
+        if (a >= 0 && b >= 0) parent_[static_cast<std::size_t>(root(a))] = root(b);
+    }
+    // groups in the order of their first body; each into the chunk with the fewest contact points so far
+    const int chunks = 4 * threads_;
+    group_bodies_.resize(static_cast<std::size_t>(chunks));
+    group_manifolds_.resize(static_cast<std::size_t>(chunks));
+    for (int c = 0; c < chunks; ++c) {
+        group_bodies_[static_cast<std::size_t>(c)].clear();
+        group_manifolds_[static_cast<std::size_t>(c)].clear();
+    }
+    std::vector<int> points(static_cast<std::size_t>(body_count), 0);  // contact points of each group, at its root
+    for (const btPersistentManifold* m : island_manifolds_) {
+        if (m->getNumContacts() == 0) continue;
+        const int a = place(m->getBody0());
+        const int k = a >= 0 ? a : place(m->getBody1());
+        points[static_cast<std::size_t>(root(k))] += m->getNumContacts();
+    }
+    group_of_root_.assign(static_cast<std::size_t>(body_count), -1);
+    std::vector<long> load(static_cast<std::size_t>(chunks), 0);
+    for (int k = 0; k < body_count; ++k) {
+        const int r = root(k);
+        int& chunk = group_of_root_[static_cast<std::size_t>(r)];
+        if (chunk < 0) {
+            chunk = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+            load[static_cast<std::size_t>(chunk)] += points[static_cast<std::size_t>(r)] + 1;
+        }
+        group_bodies_[static_cast<std::size_t>(chunk)].push_back(island_bodies_[static_cast<std::size_t>(k)]);
+    }
+    // A manifold without points gives no row. Bullet's solver would still take up its bodies, which it has from
+    // the island anyway; handed to a group that does not own them, it would write their velocities back from a
+    // second thread. It is left out.
+    for (btPersistentManifold* m : island_manifolds_) {
+        if (m->getNumContacts() == 0) continue;
+        const int a = place(m->getBody0());
+        const int k = a >= 0 ? a : place(m->getBody1());
+        group_manifolds_[static_cast<std::size_t>(group_of_root_[static_cast<std::size_t>(root(k))])].push_back(m);
+    }
+
+    while (static_cast<int>(solvers_.size()) < threads_) solvers_.push_back(std::make_unique<btMultiBodyConstraintSolver>());
+    btDispatcher* dispatcher = getCollisionWorld()->getDispatcher();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
+    for (int c = 0; c < chunks; ++c) {
+        auto& bodies = group_bodies_[static_cast<std::size_t>(c)];
+        auto& manifolds = group_manifolds_[static_cast<std::size_t>(c)];
+        if (bodies.empty()) continue;
+        btMultiBodyConstraintSolver& solver = *solvers_[static_cast<std::size_t>(omp_get_thread_num())];
+        solver.solveMultiBodyGroup(bodies.data(), static_cast<int>(bodies.size()), manifolds.empty() ? nullptr : manifolds.data(),
+                                   static_cast<int>(manifolds.size()), nullptr, 0, nullptr, 0, solverInfo, m_debugDrawer, dispatcher);
+    }
+    solveInternalConstraints(solverInfo);
 }
 
 void DynamicsWorld::predictUnconstraintMotion(btScalar timeStep)

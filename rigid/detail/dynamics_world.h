@@ -2,7 +2,11 @@
 // includes it.
 #pragma once
 
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+
+#include <memory>
+#include <vector>
 
 namespace dipper::rigid {
 
@@ -11,6 +15,14 @@ namespace dipper::rigid {
 /// after the solver) run on `threads` threads, each body exactly as Bullet's loop treats it: the same bits on
 /// any number of threads. Continuous collision detection, which those loops start and which shares the
 /// dispatcher, is not used by dipper; a body with it switched on sends its loop back to Bullet's own.
+///
+/// The constraint solver runs on the threads too, for a world of free bodies and fixed parts (no multibody, no
+/// joint, no kinematic body). Bullet solves the simulation islands in batches, one after the other; an island
+/// joins every body whose boxes overlap, so a bed of rocks is one island. Here the bodies are split into the
+/// groups that touch through contact points, and the groups are solved at the same time, each by its thread's
+/// own solver, with each group's rows in Bullet's order. A row moves only its two bodies, and a fixed part does
+/// not move, so each group's bodies receive the same operations in the same order as in Bullet's batch: the
+/// same bits (dynamics_world.cpp).
 class DynamicsWorld final : public btMultiBodyDynamicsWorld {
 public:
     DynamicsWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase, btMultiBodyConstraintSolver* solver,
@@ -24,12 +36,29 @@ protected:
     void createPredictiveContacts(btScalar timeStep) override;
     void integrateTransforms(btScalar timeStep) override;
 
+public:
+    void solveConstraints(btContactSolverInfo& solverInfo) override;
+
 private:
     /// Whether the loops may run on threads: more than one thread, and no body with continuous collision
     /// detection (whose sweep makes manifolds in the shared dispatcher).
     bool parallel() const;
+    /// Whether the islands' batches may be solved on threads: parallel(), and no multibody, joint or kinematic
+    /// body (a kinematic body is written by the solver of every batch it touches).
+    bool parallel_islands() const;
+
+    struct IslandCollector;
 
     int threads_;
+    std::vector<std::unique_ptr<btMultiBodyConstraintSolver>> solvers_;  ///< one per thread
+    // the islands' bodies and manifolds in Bullet's order, and the groups they fall into
+    std::vector<btCollisionObject*> island_bodies_;
+    std::vector<btPersistentManifold*> island_manifolds_;
+    std::vector<int> parent_;  ///< union-find over the bodies' places in island_bodies_
+    std::vector<int> local_;   ///< place in island_bodies_ of each body, by its user index 2 (dipper's body id)
+    std::vector<int> group_of_root_;
+    std::vector<std::vector<btCollisionObject*>> group_bodies_;
+    std::vector<std::vector<btPersistentManifold*>> group_manifolds_;
 };
 
 }  // namespace dipper::rigid
