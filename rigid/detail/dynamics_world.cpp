@@ -37,7 +37,9 @@ struct DynamicsWorld::IslandCollector : public btSimulationIslandManager::Island
 
 void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
 {
-    if (!parallel_islands()) {
+    // the groups give Bullet's bits only while the rows are swept in order and to the last iteration unless none
+    // changed (a residual threshold would stop a batch on the sum over all its groups)
+    if (!parallel_islands() || (solverInfo.m_solverMode & SOLVER_RANDMIZE_ORDER) || solverInfo.m_leastSquaresResidualThreshold > 0) {
         btMultiBodyDynamicsWorld::solveConstraints(solverInfo);
         return;
     }
