@@ -68,6 +68,16 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         if (static_cast<int>(local_.size()) <= id) local_.resize(static_cast<std::size_t>(id) + 1, -1);
         local_[static_cast<std::size_t>(id)] = k;
     }
+    // each manifold's moving bodies are bodies of its island (else, which Bullet's islands do not allow, one group)
+    auto listed = [&](const btCollisionObject* o) {
+        if (o->isStaticOrKinematicObject()) return true;
+        const int id = o->getUserIndex2();
+        if (id < 0 || id >= static_cast<int>(local_.size())) return false;
+        const int k = local_[static_cast<std::size_t>(id)];
+        return k >= 0 && k < body_count && island_bodies_[static_cast<std::size_t>(k)] == o;
+    };
+    for (std::size_t q = 0; q < island_manifolds_.size() && known; ++q)
+        known = listed(island_manifolds_[q]->getBody0()) && listed(island_manifolds_[q]->getBody1());
     for (int k = 0; k < body_count; ++k) parent_[static_cast<std::size_t>(k)] = known ? k : 0;
     auto root = [&](int k) {
         while (parent_[static_cast<std::size_t>(k)] != k) k = parent_[static_cast<std::size_t>(k)] = parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(k)])];
@@ -95,7 +105,7 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
         const int k = a >= 0 ? a : place(m->getBody1());
-        points[static_cast<std::size_t>(root(k))] += m->getNumContacts();
+        if (k >= 0) points[static_cast<std::size_t>(root(k))] += m->getNumContacts();
     }
     group_of_root_.assign(static_cast<std::size_t>(body_count), -1);
     std::vector<long> load(static_cast<std::size_t>(chunks), 0);
@@ -110,11 +120,12 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     }
     // A manifold without points gives no row. Bullet's solver would still take up its bodies, which it has from
     // the island anyway; handed to a group that does not own them, it would write their velocities back from a
-    // second thread. It is left out.
+    // second thread. It is left out, as is one between two fixed parts, to which Bullet gives no rows either.
     for (btPersistentManifold* m : island_manifolds_) {
         if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
         const int k = a >= 0 ? a : place(m->getBody1());
+        if (k < 0) continue;
         group_manifolds_[static_cast<std::size_t>(group_of_root_[static_cast<std::size_t>(root(k))])].push_back(m);
     }
 
