@@ -1312,20 +1312,12 @@ void World::compute_wall_contacts(double dt_s)
 {
     const std::size_t n = particles_.size();
     const bool any_wall = !walls_.empty();
-    // the small records of the walls, for the meshes moved (or changed in mass) since the last wall phase
+    // the small records of the walls: the planes' here, the meshes' at the start of the parallel part
     wall_motion_.resize(walls_.size());
     for (std::size_t q = 0; q < planes_.size(); ++q)
         wall_motion_[static_cast<std::size_t>(plane_wall_id_[q])] = {Vec3{}, Vec3{}, Vec3{}, 0.0, planes_[q].material};
     convex_frames_.resize(meshes_.size());
-    for (std::size_t m = 0; m < meshes_.size(); ++m) {
-        if (!mesh_moved_[m]) continue;
-        mesh_moved_[m] = 0;
-        const MeshWall& mw = meshes_[m];
-        const auto w = static_cast<std::size_t>(mesh_wall_id_[m]);
-        wall_motion_[w] = {mw.reference_point_m(), mw.reference_velocity_m_per_s(), mw.angular_velocity_rad_per_s(), mw.mass_kg(), mw.material()};
-        if (mw.convex())
-            convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), mesh_wall_id_[m], wall_motion_[w]};
-    }
+    const auto mesh_count = static_cast<std::ptrdiff_t>(meshes_.size());
     std::size_t convex_touching = 0;
     thread_wall_force_N_.resize(static_cast<std::size_t>(threads_));
     thread_wall_torque_N_m_.resize(static_cast<std::size_t>(threads_));
@@ -1338,6 +1330,19 @@ void World::compute_wall_contacts(double dt_s)
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
+        // the records of the meshes moved (or given a mass) since the last wall phase: in a coupled bed every rock
+        // moves at every step, a thousand records (the loop's end waits for all of them)
+#pragma omp for schedule(static)
+        for (std::ptrdiff_t q = 0; q < mesh_count; ++q) {
+            const auto m = static_cast<std::size_t>(q);
+            if (!mesh_moved_[m]) continue;
+            mesh_moved_[m] = 0;
+            const MeshWall& mw = meshes_[m];
+            const auto w = static_cast<std::size_t>(mesh_wall_id_[m]);
+            wall_motion_[w] = {mw.reference_point_m(), mw.reference_velocity_m_per_s(), mw.angular_velocity_rad_per_s(), mw.mass_kg(), mw.material()};
+            if (mw.convex())
+                convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), mesh_wall_id_[m], wall_motion_[w]};
+        }
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         wall_thread_block(t, begin, end);
