@@ -126,6 +126,9 @@ public:
     /// Torque of the same forces (and of the rolling resistance) about the wall's reference point (a mesh
     /// wall's MeshWall::reference_point_m, the origin for a plane), N m. After the first step or prepare().
     Vec3 wall_torque_N_m(int wall_id) const;
+    /// The same two for every wall, indexed by wall id (for a caller that reads them all at every step).
+    const std::vector<Vec3>& wall_forces_N() const { return wall_force_N_; }
+    const std::vector<Vec3>& wall_torques_N_m() const { return wall_torque_N_m_; }
     /// Builds the neighbour lists and computes the forces of the initial state, as the first step would;
     /// wall forces and torques are then those of the initial state. Called by step() when needed.
     void prepare();
