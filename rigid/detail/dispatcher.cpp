@@ -153,9 +153,9 @@ void Dispatcher::note_surface_gap(btBroadphasePair& pair) const
     // algorithm adds a point only where the hull (with its margin) comes within the contact breaking distance of
     // the surface: for a plane, when the hull's lowest point along the normal does; for a mesh, only if a
     // triangle's box meets the hull's box grown by the triangles' margin and the breaking distance (the hull lies
-    // in its box). Any point of the hull, and so each corner of the box Bullet turns with it, moves no farther
-    // than the growth of its odometer; a fixed surface does not move. So the pair can be passed over while that
-    // growth stays below the gap measured now, and nothing is skipped that Bullet's algorithm would have added.
+    // in its box). Any point of the hull moves no farther than the growth of its odometer, so neither does any
+    // face of its box, and a fixed surface does not move. So the pair can be passed over while that growth
+    // stays below the gap measured now, and nothing is skipped that Bullet's algorithm would have added.
     set_threshold(pair, 0.0);
     const btCollisionObject* a = object(pair.m_pProxy0);
     const btCollisionObject* b = object(pair.m_pProxy1);

@@ -100,7 +100,8 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         group_bodies_[static_cast<std::size_t>(c)].clear();
         group_manifolds_[static_cast<std::size_t>(c)].clear();
     }
-    std::vector<int> points(static_cast<std::size_t>(body_count), 0);  // contact points of each group, at its root
+    std::vector<int>& points = group_points_;  // contact points of each group, at its root
+    points.assign(static_cast<std::size_t>(body_count), 0);
     for (const btPersistentManifold* m : island_manifolds_) {
         if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
@@ -108,7 +109,8 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         if (k >= 0) points[static_cast<std::size_t>(root(k))] += m->getNumContacts();
     }
     group_of_root_.assign(static_cast<std::size_t>(body_count), -1);
-    std::vector<long> load(static_cast<std::size_t>(chunks), 0);
+    std::vector<long>& load = chunk_points_;
+    load.assign(static_cast<std::size_t>(chunks), 0);
     for (int k = 0; k < body_count; ++k) {
         const int r = root(k);
         int& chunk = group_of_root_[static_cast<std::size_t>(r)];

@@ -1,5 +1,5 @@
-// Bullet's multibody world with its per-body loops spread over threads. Not installed; nothing outside rigid/
-// includes it.
+// Bullet's multibody world with its per-body loops and, for free bodies and fixed parts, its constraint solver
+// spread over threads. Not installed; nothing outside rigid/ includes it.
 #pragma once
 
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
@@ -57,6 +57,8 @@ private:
     std::vector<int> parent_;  ///< union-find over the bodies' places in island_bodies_
     std::vector<int> local_;   ///< place in island_bodies_ of each body, by its user index 2 (dipper's body id)
     std::vector<int> group_of_root_;
+    std::vector<int> group_points_;   ///< contact points of each group, at its root's place
+    std::vector<long> chunk_points_;  ///< contact points given to each chunk so far
     std::vector<std::vector<btCollisionObject*>> group_bodies_;
     std::vector<std::vector<btPersistentManifold*>> group_manifolds_;
 };

@@ -162,13 +162,29 @@ int main(int argc, char** argv)
     // every variant's bed, loaded from the cache and warmed up; then they take turns of --turn DEM steps each
     // until each has timed --steps (one turn by default: each variant in one go, as before)
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
-    if (turn <= 0) turn = steps;
-    for (int n : variants)
-        if (n < 0 || (n > 0 && turn % n != 0) || steps % turn != 0) {
-            std::fprintf(stderr, "--turn %d: expected a divisor of --steps %d and a multiple of every --substeps value (%d is not)\n",
-                         turn, steps, n);
+    if (steps < 1) {
+        std::fprintf(stderr, "--steps %d: expected a number of timed DEM steps >= 1\n", steps);
+        return 2;
+    }
+    if (turn < 0) {
+        std::fprintf(stderr, "--turn %d: expected a number of DEM steps >= 1 (or 0: each variant in one go)\n", turn);
+        return 2;
+    }
+    if (turn == 0) turn = steps;
+    if (steps % turn != 0) {
+        std::fprintf(stderr, "--turn %d: expected a divisor of --steps %d\n", turn, steps);
+        return 2;
+    }
+    for (int n : variants) {
+        if (n < 0) {
+            std::fprintf(stderr, "--substeps: %d is negative; expected DEM steps per rigid-body step >= 1 (0: the DEM alone)\n", n);
             return 2;
         }
+        if (n > 0 && turn % n != 0) {
+            std::fprintf(stderr, "--turn %d: expected a multiple of each --substeps value; %d is not a divisor of it\n", turn, n);
+            return 2;
+        }
+    }
     struct Run {
         int n;
         std::string name;

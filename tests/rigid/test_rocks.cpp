@@ -29,18 +29,26 @@ ConvexPolyhedron regular_tetrahedron(double edge)
     return ConvexPolyhedron::hull_of({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}}, "tetrahedron");
 }
 
+/// A world of `s` with the materials rock (0) and `other` (1), and the friction and restitution of rock on rock
+/// and of rock on the other.
+RigidWorld rock_world(const RigidSettings& s, const std::string& other, double rock_friction, double rock_restitution,
+                      double other_friction, double other_restitution)
+{
+    RigidWorld w(s);
+    w.add_material("rock");
+    w.add_material(other);
+    w.set_pair("rock", "rock", rock_friction, rock_restitution);
+    w.set_pair("rock", other, other_friction, other_restitution);
+    return w;
+}
+
 /// A world with materials rock and ground and their pairs.
 RigidWorld rock_world(double step_s, double friction = 0.6, int iterations = 10)
 {
     RigidSettings s;
     s.step_s = step_s;
     s.solver_iterations = iterations;
-    RigidWorld w(s);
-    w.add_material("rock");
-    w.add_material("ground");
-    w.set_pair("rock", "rock", friction, 0.2);
-    w.set_pair("rock", "ground", friction, 0.2);
-    return w;
+    return rock_world(s, "ground", friction, 0.2, friction, 0.2);
 }
 
 /// Lowest point of the true polyhedron at a body's pose.
@@ -379,11 +387,7 @@ Throw throw_rocks(std::uint64_t seed, bool onto_plate, bool bullet_pairs, int th
     s.gravity_m_per_s2 = onto_plate ? Vec3{0.0, 0.0, -9.81} : Vec3{};
     s.bullet_convex_pairs = bullet_pairs;
     s.threads = threads;
-    RigidWorld w(s);
-    w.add_material("rock");
-    w.add_material("steel");
-    w.set_pair("rock", "rock", 0.7, 0.3);
-    w.set_pair("rock", "steel", 0.5, 0.3);
+    RigidWorld w = rock_world(s, "steel", 0.7, 0.3, 0.5, 0.3);
     auto spin = [&](double rate) { return Vec3{u(rng), u(rng), u(rng)} * rate; };
     std::vector<BodyId> rocks;
     const ConvexPolyhedron a = generate_rock({0.6, 1.8, 2.0, 20}, 100 + seed);
@@ -453,11 +457,7 @@ Drop drop_into_box(int threads, bool bullet_pairs)
     s.step_s = 1e-3;
     s.threads = threads;
     s.bullet_convex_pairs = bullet_pairs;
-    RigidWorld w(s);
-    w.add_material("rock");
-    w.add_material("ground");
-    w.set_pair("rock", "rock", 0.85, 0.1);
-    w.set_pair("rock", "ground", 0.8, 0.1);
+    RigidWorld w = rock_world(s, "ground", 0.85, 0.1, 0.8, 0.1);
     const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
     const BodyId box = w.add_static_mesh(meshes::make_open_box_mesh(3.0, 3.0, 2.0, 1.0), 1, "box");
     const double sizes[4] = {0.3, 0.4, 0.6, 0.85};
@@ -546,11 +546,7 @@ Throw throw_at_surface(std::uint64_t seed, bool mesh, bool spin, int threads)
     RigidSettings s;
     s.step_s = 1e-3;
     s.threads = threads;
-    RigidWorld w(s);
-    w.add_material("rock");
-    w.add_material("ground");
-    w.set_pair("rock", "rock", 0.7, 0.3);
-    w.set_pair("rock", "ground", 0.6, 0.4);
+    RigidWorld w = rock_world(s, "ground", 0.7, 0.3, 0.6, 0.4);
     const BodyId surface = mesh ? w.add_static_mesh(meshes::make_open_box_mesh(4.0, 4.0, 3.0, 1.0), 1, "box")
                                 : w.add_ground_plane(0.0, 1, "ground");
     const ConvexPolyhedron shape = generate_rock({0.6, 1.8, 2.0, 20}, 300 + seed);
