@@ -16,30 +16,31 @@ bool DynamicsWorld::parallel() const
     return true;
 }
 
-bool DynamicsWorld::parallel_islands() const
+bool DynamicsWorld::grouped(const btContactSolverInfo& info) const
 {
-    if (!parallel() || m_multiBodies.size() > 0 || m_constraints.size() > 0 || m_multiBodyConstraints.size() > 0) return false;
-    for (int i = 0; i < m_collisionObjects.size(); ++i)
-        if (m_collisionObjects[i]->isKinematicObject()) return false;
+    // the groups give the same bits on any number of threads only while the rows are swept in order and to the
+    // last iteration unless none changed (a residual threshold would stop a chunk on the sum over its groups)
+    if ((info.m_solverMode & SOLVER_RANDMIZE_ORDER) || info.m_leastSquaresResidualThreshold > 0) return false;
+    if (m_multiBodies.size() > 0 || m_constraints.size() > 0 || m_multiBodyConstraints.size() > 0) return false;
+    for (int i = 0; i < m_collisionObjects.size(); ++i) {
+        const btCollisionObject* o = m_collisionObjects[i];
+        if (o->isKinematicObject()) return false;
+        if (!o->isStaticObject() && o->getActivationState() != DISABLE_DEACTIVATION) return false;  // it may sleep
+    }
     return true;
 }
 
-/// Collects the islands' bodies and manifolds in the order Bullet's island manager hands them out.
-struct DynamicsWorld::IslandCollector : public btSimulationIslandManager::IslandCallback {
-    explicit IslandCollector(DynamicsWorld& w) : world(w) {}
-    void processIsland(btCollisionObject** bodies, int body_count, btPersistentManifold** manifolds, int manifold_count, int) override
-    {
-        world.island_bodies_.insert(world.island_bodies_.end(), bodies, bodies + body_count);
-        world.island_manifolds_.insert(world.island_manifolds_.end(), manifolds, manifolds + manifold_count);
-    }
-    DynamicsWorld& world;
-};
+void DynamicsWorld::calculateSimulationIslands()
+{
+    // Bullet's islands join every two bodies whose boxes overlap, for its solver's batches and for putting
+    // bodies to sleep; the solver's groups below take their place where no body may sleep
+    if (grouped(getSolverInfo())) return;
+    btMultiBodyDynamicsWorld::calculateSimulationIslands();
+}
 
 void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
 {
-    // the groups give Bullet's bits only while the rows are swept in order and to the last iteration unless none
-    // changed (a residual threshold would stop a batch on the sum over all its groups)
-    if (!parallel_islands() || (solverInfo.m_solverMode & SOLVER_RANDMIZE_ORDER) || solverInfo.m_leastSquaresResidualThreshold > 0) {
+    if (!grouped(solverInfo)) {
         btMultiBodyDynamicsWorld::solveConstraints(solverInfo);
         return;
     }
@@ -47,10 +48,17 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     // done here: first the external forces and the set-up of Bullet's own batch list, which stays empty; last
     // its empty remainder, allSolved and the multibodies' velocities (none here).
     solveExternalForces(solverInfo);
+    // every moving body (each passes through the solver, which adds its external forces to its velocity), and
+    // every manifold with points between bodies that respond to contact, in the dispatcher's order
     island_bodies_.clear();
     island_manifolds_.clear();
-    IslandCollector collector(*this);
-    m_islandManager->buildAndProcessIslands(getCollisionWorld()->getDispatcher(), getCollisionWorld(), &collector);
+    for (int i = 0; i < m_collisionObjects.size(); ++i)
+        if (!m_collisionObjects[i]->isStaticOrKinematicObject()) island_bodies_.push_back(m_collisionObjects[i]);
+    btDispatcher* dispatcher = getCollisionWorld()->getDispatcher();
+    for (int i = 0; i < dispatcher->getNumManifolds(); ++i) {
+        btPersistentManifold* m = dispatcher->getManifoldByIndexInternal(i);
+        if (m->getNumContacts() > 0 && dispatcher->needsResponse(m->getBody0(), m->getBody1())) island_manifolds_.push_back(m);
+    }
 
     // Groups of bodies that touch through contact points. Bullet's solver turns the points of a batch's
     // manifolds into rows and sweeps them in order; a row reads and moves only the velocities of its two bodies
@@ -132,7 +140,6 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     }
 
     while (static_cast<int>(solvers_.size()) < threads_) solvers_.push_back(std::make_unique<btMultiBodyConstraintSolver>());
-    btDispatcher* dispatcher = getCollisionWorld()->getDispatcher();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
     for (int c = 0; c < chunks; ++c) {
         auto& bodies = group_bodies_[static_cast<std::size_t>(c)];

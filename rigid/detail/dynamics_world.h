@@ -16,13 +16,14 @@ namespace dipper::rigid {
 /// any number of threads. Continuous collision detection, which those loops start and which shares the
 /// dispatcher, is not used by dipper; a body with it switched on sends its loop back to Bullet's own.
 ///
-/// The constraint solver runs on the threads too, for a world of free bodies and fixed parts (no multibody, no
-/// joint, no kinematic body). Bullet solves the simulation islands in batches, one after the other; an island
-/// joins every body whose boxes overlap, so a bed of rocks is one island. Here the bodies are split into the
+/// The constraint solver runs on the threads too, for a world of free bodies that never sleep and fixed parts
+/// (no multibody, no joint, no kinematic body). Bullet solves the simulation islands in batches, one after the
+/// other; an island joins every body whose boxes overlap, so a bed of rocks is one island, and building the
+/// islands each step is work on one thread. Here the islands are not built: the bodies are split into the
 /// groups that touch through contact points, and the groups are solved at the same time, each by its thread's
-/// own solver, with each group's rows in Bullet's order. A row moves only its two bodies, and a fixed part does
-/// not move, so each group's bodies receive the same operations in the same order as in Bullet's batch: the
-/// same bits (dynamics_world.cpp).
+/// own solver, with each group's rows in the order of the dispatcher's manifolds. A row moves only its two
+/// bodies, and a fixed part does not move, so each group's bodies receive the same operations in the same
+/// order on any number of threads: the same bits (dynamics_world.cpp).
 class DynamicsWorld final : public btMultiBodyDynamicsWorld {
 public:
     DynamicsWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase, btMultiBodyConstraintSolver* solver,
@@ -35,6 +36,7 @@ protected:
     void predictUnconstraintMotion(btScalar timeStep) override;
     void createPredictiveContacts(btScalar timeStep) override;
     void integrateTransforms(btScalar timeStep) override;
+    void calculateSimulationIslands() override;
 
 public:
     void solveConstraints(btContactSolverInfo& solverInfo) override;
@@ -43,15 +45,14 @@ private:
     /// Whether the loops may run on threads: more than one thread, and no body with continuous collision
     /// detection (whose sweep makes manifolds in the shared dispatcher).
     bool parallel() const;
-    /// Whether the islands' batches may be solved on threads: parallel(), and no multibody, joint or kinematic
-    /// body (a kinematic body is written by the solver of every batch it touches).
-    bool parallel_islands() const;
-
-    struct IslandCollector;
+    /// Whether the solver's groups replace Bullet's islands: no multibody, joint or kinematic body (a kinematic
+    /// body is written by the solver of every group it touches), no body that may sleep (the islands decide
+    /// that), rows swept in order with no residual threshold. On any number of threads.
+    bool grouped(const btContactSolverInfo& info) const;
 
     int threads_;
     std::vector<std::unique_ptr<btMultiBodyConstraintSolver>> solvers_;  ///< one per thread
-    // the islands' bodies and manifolds in Bullet's order, and the groups they fall into
+    // the moving bodies and the manifolds with points, and the groups they fall into
     std::vector<btCollisionObject*> island_bodies_;
     std::vector<btPersistentManifold*> island_manifolds_;
     std::vector<int> parent_;  ///< union-find over the bodies' places in island_bodies_
