@@ -172,19 +172,15 @@ void DynamicsWorld::predictUnconstraintMotion(btScalar timeStep)
 
 void DynamicsWorld::createPredictiveContacts(btScalar timeStep)
 {
-    if (!parallel()) {
-        btMultiBodyDynamicsWorld::createPredictiveContacts(timeStep);
-        return;
-    }
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i)
+        if (m_nonStaticRigidBodies[i]->getCcdSquareMotionThreshold() != 0) {
+            btMultiBodyDynamicsWorld::createPredictiveContacts(timeStep);
+            return;
+        }
+    // Without continuous collision detection Bullet's pass (createPredictiveContactsInternal) predicts each
+    // body's pose only to compare its motion with a zero threshold: what is left is the hit fractions it resets
     releasePredictiveContacts();
-    const int n = m_nonStaticRigidBodies.size();
-#pragma omp parallel num_threads(threads_)
-    {
-        // Bullet marks this loop as one that may run on parts of the body list at once
-        const int t = omp_get_thread_num(), count = omp_get_num_threads();
-        const int begin = n * t / count, end = n * (t + 1) / count;
-        if (end > begin) createPredictiveContactsInternal(&m_nonStaticRigidBodies[begin], end - begin, timeStep);
-    }
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) m_nonStaticRigidBodies[i]->setHitFraction(1);
 }
 
 void DynamicsWorld::integrateTransforms(btScalar timeStep)

@@ -10,11 +10,12 @@
 
 namespace dipper::rigid {
 
-/// btMultiBodyDynamicsWorld whose three loops over the rigid bodies that touch only one body each (the damping
-/// and predicted pose before the collision search, the predictive-contact pass, the integration of the poses
-/// after the solver) run on `threads` threads, each body exactly as Bullet's loop treats it: the same bits on
-/// any number of threads. Continuous collision detection, which those loops start and which shares the
-/// dispatcher, is not used by dipper; a body with it switched on sends its loop back to Bullet's own.
+/// btMultiBodyDynamicsWorld whose two loops over the rigid bodies that touch only one body each (the damping
+/// and predicted pose before the collision search, the integration of the poses after the solver) run on
+/// `threads` threads, each body exactly as Bullet's loop treats it: the same bits on any number of threads.
+/// Continuous collision detection, which those loops start and which shares the dispatcher, is not used by
+/// dipper; a body with it switched on sends its loop back to Bullet's own. Without it the predictive-contact
+/// pass has nothing to do but reset the hit fractions, and does only that.
 ///
 /// The constraint solver runs on the threads too, for a world of free bodies that never sleep and fixed parts
 /// (no multibody, no joint, no kinematic body). Bullet solves the simulation islands in batches, one after the
