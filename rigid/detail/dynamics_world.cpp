@@ -24,8 +24,7 @@ bool DynamicsWorld::grouped(const btContactSolverInfo& info) const
     if (m_multiBodies.size() > 0 || m_constraints.size() > 0 || m_multiBodyConstraints.size() > 0) return false;
     for (int i = 0; i < m_collisionObjects.size(); ++i) {
         const btCollisionObject* o = m_collisionObjects[i];
-        if (o->isKinematicObject()) return false;
-        if (!o->isStaticObject() && o->getActivationState() != DISABLE_DEACTIVATION) return false;  // it may sleep
+        if (!o->isStaticOrKinematicObject() && o->getActivationState() != DISABLE_DEACTIVATION) return false;  // it may sleep
     }
     return true;
 }
@@ -48,12 +47,17 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     // done here: first the external forces and the set-up of Bullet's own batch list, which stays empty; last
     // its empty remainder, allSolved and the multibodies' velocities (none here).
     solveExternalForces(solverInfo);
-    // every moving body (each passes through the solver, which adds its external forces to its velocity), and
-    // every manifold with points between bodies that respond to contact, in the dispatcher's order
+    // every moving body (each passes through the solver, which adds its external forces to its velocity), then
+    // the kinematic parts; every manifold with points between bodies that respond to contact, in the
+    // dispatcher's order
     island_bodies_.clear();
     island_manifolds_.clear();
     for (int i = 0; i < m_collisionObjects.size(); ++i)
         if (!m_collisionObjects[i]->isStaticOrKinematicObject()) island_bodies_.push_back(m_collisionObjects[i]);
+    const int body_count = static_cast<int>(island_bodies_.size());
+    for (int i = 0; i < m_collisionObjects.size(); ++i)
+        if (m_collisionObjects[i]->isKinematicObject()) island_bodies_.push_back(m_collisionObjects[i]);
+    const int node_count = static_cast<int>(island_bodies_.size());
     btDispatcher* dispatcher = getCollisionWorld()->getDispatcher();
     for (int i = 0; i < dispatcher->getNumManifolds(); ++i) {
         btPersistentManifold* m = dispatcher->getManifoldByIndexInternal(i);
@@ -66,33 +70,35 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     // So the rows of one group, swept in the same order without the others', give its bodies the same bits. The
     // sweeps stop early only when no row changed at all (the residual threshold is 0), which then holds for
     // every group. Each body without a contact point is a group of its own.
-    const int body_count = static_cast<int>(island_bodies_.size());
-    parent_.resize(static_cast<std::size_t>(body_count));
+    // A kinematic part joins the groups it touches into one: it is not moved by its rows (zero inverse mass), but
+    // the solver writes its velocity back, which only one thread may do. A fixed part joins nothing.
+    parent_.resize(static_cast<std::size_t>(node_count));
     bool known = true;  // every body carries dipper's body id (else all of them form one group)
-    for (int k = 0; k < body_count; ++k) {
+    for (int k = 0; k < node_count; ++k) {
         const int id = island_bodies_[static_cast<std::size_t>(k)]->getUserIndex2();
         known = known && id >= 0;
         if (!known) break;
         if (static_cast<int>(local_.size()) <= id) local_.resize(static_cast<std::size_t>(id) + 1, -1);
         local_[static_cast<std::size_t>(id)] = k;
     }
-    // each manifold's moving bodies are bodies of its island (else, which Bullet's islands do not allow, one group)
+    // each manifold's moving and kinematic bodies are listed (else, which the world does not allow, one group)
+    auto fixed = [](const btCollisionObject* o) { return o->isStaticOrKinematicObject() && !o->isKinematicObject(); };
     auto listed = [&](const btCollisionObject* o) {
-        if (o->isStaticOrKinematicObject()) return true;
+        if (fixed(o)) return true;
         const int id = o->getUserIndex2();
         if (id < 0 || id >= static_cast<int>(local_.size())) return false;
         const int k = local_[static_cast<std::size_t>(id)];
-        return k >= 0 && k < body_count && island_bodies_[static_cast<std::size_t>(k)] == o;
+        return k >= 0 && k < node_count && island_bodies_[static_cast<std::size_t>(k)] == o;
     };
     for (std::size_t q = 0; q < island_manifolds_.size() && known; ++q)
         known = listed(island_manifolds_[q]->getBody0()) && listed(island_manifolds_[q]->getBody1());
-    for (int k = 0; k < body_count; ++k) parent_[static_cast<std::size_t>(k)] = known ? k : 0;
+    for (int k = 0; k < node_count; ++k) parent_[static_cast<std::size_t>(k)] = known ? k : 0;
     auto root = [&](int k) {
         while (parent_[static_cast<std::size_t>(k)] != k) k = parent_[static_cast<std::size_t>(k)] = parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(k)])];
         return k;
     };
     auto place = [&](const btCollisionObject* o) {
-        if (o->isStaticOrKinematicObject()) return -1;
+        if (fixed(o)) return -1;
         return known ? local_[static_cast<std::size_t>(o->getUserIndex2())] : 0;
     };
     for (const btPersistentManifold* m : island_manifolds_) {
@@ -109,14 +115,14 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         group_manifolds_[static_cast<std::size_t>(c)].clear();
     }
     std::vector<int>& points = group_points_;  // contact points of each group, at its root
-    points.assign(static_cast<std::size_t>(body_count), 0);
+    points.assign(static_cast<std::size_t>(node_count), 0);
     for (const btPersistentManifold* m : island_manifolds_) {
         if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
         const int k = a >= 0 ? a : place(m->getBody1());
         if (k >= 0) points[static_cast<std::size_t>(root(k))] += m->getNumContacts();
     }
-    group_of_root_.assign(static_cast<std::size_t>(body_count), -1);
+    group_of_root_.assign(static_cast<std::size_t>(node_count), -1);
     std::vector<long>& load = chunk_points_;
     load.assign(static_cast<std::size_t>(chunks), 0);
     for (int k = 0; k < body_count; ++k) {
@@ -135,8 +141,8 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
         const int k = a >= 0 ? a : place(m->getBody1());
-        if (k < 0) continue;
-        group_manifolds_[static_cast<std::size_t>(group_of_root_[static_cast<std::size_t>(root(k))])].push_back(m);
+        const int chunk = k < 0 ? -1 : group_of_root_[static_cast<std::size_t>(root(k))];
+        if (chunk >= 0) group_manifolds_[static_cast<std::size_t>(chunk)].push_back(m);  // (a kinematic part alone has no row)
     }
 
     while (static_cast<int>(solvers_.size()) < threads_) solvers_.push_back(std::make_unique<btMultiBodyConstraintSolver>());

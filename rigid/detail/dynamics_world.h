@@ -17,14 +17,15 @@ namespace dipper::rigid {
 /// dipper; a body with it switched on sends its loop back to Bullet's own. Without it the predictive-contact
 /// pass has nothing to do but reset the hit fractions, and does only that.
 ///
-/// The constraint solver runs on the threads too, for a world of free bodies that never sleep and fixed parts
-/// (no multibody, no joint, no kinematic body). Bullet solves the simulation islands in batches, one after the
+/// The constraint solver runs on the threads too, for a world of free bodies that never sleep, fixed parts and
+/// kinematic parts (no multibody, no joint). Bullet solves the simulation islands in batches, one after the
 /// other; an island joins every body whose boxes overlap, so a bed of rocks is one island, and building the
 /// islands each step is work on one thread. Here the islands are not built: the bodies are split into the
-/// groups that touch through contact points, and the groups are solved at the same time, each by its thread's
-/// own solver, with each group's rows in the order of the dispatcher's manifolds. A row moves only its two
-/// bodies, and a fixed part does not move, so each group's bodies receive the same operations in the same
-/// order on any number of threads: the same bits (dynamics_world.cpp).
+/// groups that touch through contact points (a kinematic part joins the groups it touches, as only one thread
+/// may write its velocity back), and the groups are solved at the same time, each by its thread's own solver,
+/// with each group's rows in the order of the dispatcher's manifolds. A row moves only its two bodies, and a
+/// fixed or kinematic part is not moved by its rows, so each group's bodies receive the same operations in the
+/// same order on any number of threads: the same bits (dynamics_world.cpp).
 class DynamicsWorld final : public btMultiBodyDynamicsWorld {
 public:
     DynamicsWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase, btMultiBodyConstraintSolver* solver,
@@ -46,9 +47,8 @@ private:
     /// Whether the loops may run on threads: more than one thread, and no body with continuous collision
     /// detection (whose sweep makes manifolds in the shared dispatcher).
     bool parallel() const;
-    /// Whether the solver's groups replace Bullet's islands: no multibody, joint or kinematic body (a kinematic
-    /// body is written by the solver of every group it touches), no body that may sleep (the islands decide
-    /// that), rows swept in order with no residual threshold. On any number of threads.
+    /// Whether the solver's groups replace Bullet's islands: no multibody or joint, no body that may sleep (the
+    /// islands decide that), rows swept in order with no residual threshold. On any number of threads.
     bool grouped(const btContactSolverInfo& info) const;
 
     int threads_;
