@@ -1,7 +1,5 @@
 #include "rigid/detail/dynamics_world.h"
 
-#include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
-
 #include <algorithm>
 
 #include <omp.h>
@@ -49,7 +47,8 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     solveExternalForces(solverInfo);
     // every moving body (each passes through the solver, which adds its external forces to its velocity), then
     // the kinematic parts; every manifold with points between bodies that respond to contact, in the
-    // dispatcher's order
+    // dispatcher's order. A manifold without points gives no row; handed to a group that does not own its
+    // bodies, Bullet's solver would still write their velocities back from a second thread, so it is left out.
     island_bodies_.clear();
     island_manifolds_.clear();
     for (int i = 0; i < m_collisionObjects.size(); ++i)
@@ -102,7 +101,6 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         return known ? local_[static_cast<std::size_t>(o->getUserIndex2())] : 0;
     };
     for (const btPersistentManifold* m : island_manifolds_) {
-        if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0()), b = place(m->getBody1());
         if (a >= 0 && b >= 0) parent_[static_cast<std::size_t>(root(a))] = root(b);
     }
@@ -117,7 +115,6 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
     std::vector<int>& points = group_points_;  // contact points of each group, at its root
     points.assign(static_cast<std::size_t>(node_count), 0);
     for (const btPersistentManifold* m : island_manifolds_) {
-        if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
         const int k = a >= 0 ? a : place(m->getBody1());
         if (k >= 0) points[static_cast<std::size_t>(root(k))] += m->getNumContacts();
@@ -134,11 +131,8 @@ void DynamicsWorld::solveConstraints(btContactSolverInfo& solverInfo)
         }
         group_bodies_[static_cast<std::size_t>(chunk)].push_back(island_bodies_[static_cast<std::size_t>(k)]);
     }
-    // A manifold without points gives no row. Bullet's solver would still take up its bodies, which it has from
-    // the island anyway; handed to a group that does not own them, it would write their velocities back from a
-    // second thread. It is left out, as is one between two fixed parts, to which Bullet gives no rows either.
+    // each manifold to its group's chunk
     for (btPersistentManifold* m : island_manifolds_) {
-        if (m->getNumContacts() == 0) continue;
         const int a = place(m->getBody0());
         const int k = a >= 0 ? a : place(m->getBody1());
         const int chunk = k < 0 ? -1 : group_of_root_[static_cast<std::size_t>(root(k))];

@@ -1,5 +1,5 @@
-// Bullet's multibody world with its per-body loops and, for free bodies and fixed parts, its constraint solver
-// spread over threads. Not installed; nothing outside rigid/ includes it.
+// Bullet's multibody world with its per-body loops and, for free bodies with fixed and kinematic parts, its
+// constraint solver spread over threads. Not installed; nothing outside rigid/ includes it.
 #pragma once
 
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
@@ -53,10 +53,10 @@ private:
 
     int threads_;
     std::vector<std::unique_ptr<btMultiBodyConstraintSolver>> solvers_;  ///< one per thread
-    // the moving bodies and the manifolds with points, and the groups they fall into
+    // the moving bodies, then the kinematic parts; the manifolds with points; the groups they fall into
     std::vector<btCollisionObject*> island_bodies_;
     std::vector<btPersistentManifold*> island_manifolds_;
-    std::vector<int> parent_;  ///< union-find over the bodies' places in island_bodies_
+    std::vector<int> parent_;  ///< union-find over the places in island_bodies_
     std::vector<int> local_;   ///< place in island_bodies_ of each body, by its user index 2 (dipper's body id)
     std::vector<int> group_of_root_;
     std::vector<int> group_points_;   ///< contact points of each group, at its root's place
