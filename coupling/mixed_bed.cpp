@@ -141,6 +141,59 @@ private:
     std::vector<double> radii_;
 };
 
+/// The placed rocks by cells of a uniform grid: each rock is listed in every cell its bounding sphere's box
+/// meets, so two rocks whose bounding spheres overlap share a cell. Placing a pile of 20,000 rocks then costs
+/// the rocks near each try, not all of those placed before it.
+class RockGrid {
+public:
+    RockGrid(const Vec3& lo, double cell) : lo_(lo), cell_(cell) {}
+    void add(std::uint32_t rock, const Vec3& centre, double radius)
+    {
+        for_cells(centre, radius, [&](std::int64_t key) { cells_[key].push_back(rock); });
+        stamp_.push_back(0);
+    }
+    /// Calls `near(rock)` once for each rock listed in a cell that the sphere's box meets, until it returns false.
+    template <class Near>
+    bool all_of_near(const Vec3& centre, double radius, Near near)
+    {
+        ++query_;
+        bool all = true;
+        for_cells(centre, radius, [&](std::int64_t key) {
+            if (!all) return;
+            const auto it = cells_.find(key);
+            if (it == cells_.end()) return;
+            for (std::uint32_t rock : it->second) {
+                if (stamp_[rock] == query_) continue;
+                stamp_[rock] = query_;
+                if (!near(rock)) {
+                    all = false;
+                    return;
+                }
+            }
+        });
+        return all;
+    }
+
+private:
+    template <class Visit>
+    void for_cells(const Vec3& centre, double radius, Visit visit) const
+    {
+        int from[3], to[3];
+        for (int a = 0; a < 3; ++a) {
+            from[a] = static_cast<int>(std::floor((centre[a] - radius - lo_[a]) / cell_));
+            to[a] = static_cast<int>(std::floor((centre[a] + radius - lo_[a]) / cell_));
+        }
+        for (int k = from[2]; k <= to[2]; ++k)
+            for (int j = from[1]; j <= to[1]; ++j)
+                for (int i = from[0]; i <= to[0]; ++i) visit((static_cast<std::int64_t>(i) * 100003 + j) * 100019 + k);
+    }
+    Vec3 lo_;
+    double cell_;
+    std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
+    std::vector<std::uint64_t> stamp_;  ///< per rock: the last query that met it
+    std::uint64_t query_ = 0;
+};
+
 }  // namespace
 
 MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, const MixedDistribution& distribution,
@@ -166,9 +219,13 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
 
     // what is already there: rocks made by add_rock, and spheres
     std::vector<PlacedRock> placed;
+    double largest_class_m = 0.0;
+    for (const RockClass& rc : distribution.rocks) largest_class_m = std::max(largest_class_m, rc.size_m);
+    RockGrid placed_grid(lo, std::max(largest_class_m, 2.0 * distribution.sphere_radius_m));
     for (const RockRecord& r : world.rocks()) {
         const rigid::BodyState s = world.rigid().state(r.body);
         placed.push_back(place(r.shape, s.rotation, s.position_m));
+        placed_grid.add(static_cast<std::uint32_t>(placed.size() - 1), placed.back().centre, placed.back().radius);
     }
     const double rs = distribution.sphere_radius_m;
     SphereGrid grid(lo, hi, 2.0 * std::max(rs, [&] {
@@ -207,11 +264,11 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
                                   c_min.z + u(rng) * (c_max.z - c_min.z)};
                 PlacedRock candidate = place(shape, r, centre);
                 if (keep && !keep(centre, candidate.radius)) continue;
-                bool clear = true;
-                for (const PlacedRock& o : placed) {
-                    if (norm(o.centre - centre) > o.radius + candidate.radius) continue;
-                    if (!separated_by_faces(o, candidate, 0.0) && !separated_by_faces(candidate, o, 0.0)) { clear = false; break; }
-                }
+                bool clear = placed_grid.all_of_near(centre, candidate.radius, [&](std::uint32_t q) {
+                    const PlacedRock& o = placed[q];
+                    return norm(o.centre - centre) > o.radius + candidate.radius || separated_by_faces(o, candidate, 0.0) ||
+                           separated_by_faces(candidate, o, 0.0);
+                });
                 if (!clear) continue;
                 // spheres already in the world
                 for (std::size_t i = 0; i < dem.particles().size() && clear; ++i)
@@ -219,6 +276,7 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
                 if (!clear) continue;
                 world.add_rock(shape, materials.density_kg_per_m3, materials.rigid_rock, materials.rock, centre, r);
                 placed.push_back(std::move(candidate));
+                placed_grid.add(static_cast<std::uint32_t>(placed.size() - 1), placed.back().centre, placed.back().radius);
                 report.rock_mass_kg += materials.density_kg_per_m3 * shape.volume_m3();
                 ++report.rocks_per_class[c];
                 done = true;

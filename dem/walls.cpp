@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace dipper::dem {
@@ -38,6 +39,9 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
         const auto& tri = mesh_.triangles()[t];
         packed_body_[t] = {v[tri[0]], v[tri[1]], v[tri[2]], mesh_.triangle_normal(t)};
     }
+    constexpr double kHuge = std::numeric_limits<double>::max();
+    bounds_lo_m_ = {kHuge, kHuge, kHuge};  // an empty mesh: every sphere is clear of it
+    bounds_hi_m_ = {-kHuge, -kHuge, -kHuge};
     if (!v.empty()) {
         Vec3 lo = v[0], hi = v[0];
         for (const Vec3& x : v) {
@@ -45,6 +49,8 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
             hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
         }
         bound_centre_ = (lo + hi) * 0.5;
+        bounds_lo_m_ = lo;
+        bounds_hi_m_ = hi;
         for (const Vec3& x : v) bound_radius_m_ = std::max(bound_radius_m_, norm(x - bound_centre_));
     }
     // a closed convex solid: every edge shared by exactly two triangles (an open plate or shell is a two-sided
@@ -78,7 +84,8 @@ MeshWall::MeshWall(meshes::TriangleMesh mesh, MaterialIndex material, std::strin
 bool MeshWall::sphere_clear(const Vec3& centre_world_m, double r) const
 {
     const Vec3 b = to_body(centre_world_m);
-    const Vec3 lo = mesh_.bounds_min_m(), hi = mesh_.bounds_max_m();
+    const Vec3& lo = bounds_lo_m_;
+    const Vec3& hi = bounds_hi_m_;
     if (b.x < lo.x - r || b.y < lo.y - r || b.z < lo.z - r || b.x > hi.x + r || b.y > hi.y + r || b.z > hi.z + r) return true;
     return mesh_.distance_m(b) >= r;
 }

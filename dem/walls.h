@@ -120,6 +120,7 @@ private:
     std::vector<PackedTriangle> packed_body_;
     Vec3 bound_centre_;        ///< body frame
     double bound_radius_m_ = 0.0;
+    Vec3 bounds_lo_m_, bounds_hi_m_;  ///< the body-frame box of the vertices (sphere_clear)
     mutable std::vector<Vec3> vertices_world_;
     mutable bool vertices_current_ = false;
     std::uint64_t pose_version_ = 0;

@@ -61,8 +61,7 @@ void World::check_wall_name(const std::string& name) const
     });
     if (!plain)
         throw InputError(concat("wall name '", name, "' must be non-empty and use only letters, digits, '_', '-' and '.'"));
-    for (std::size_t w = 0; w < walls_.size(); ++w)
-        if (wall_name(static_cast<int>(w)) == name) throw InputError(concat("wall name '", name, "' is used twice"));
+    if (wall_names_.count(name)) throw InputError(concat("wall name '", name, "' is used twice"));
 }
 
 int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex material, const std::string& name)
@@ -76,6 +75,7 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
     planes_.push_back({point_m, normalized(normal), material, name});
     plane_offset_m_.push_back(dot(planes_.back().point_m, planes_.back().normal));
     walls_.push_back({false, static_cast<int>(planes_.size() - 1)});
+    wall_names_.insert(name);
     plane_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
     wall_force_N_.resize(walls_.size());
     wall_torque_N_m_.resize(walls_.size());
@@ -104,6 +104,7 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
                                 motion->angular_velocity_rad_per_s);
     }
     walls_.push_back({true, static_cast<int>(meshes_.size() - 1)});
+    wall_names_.insert(name);
     mesh_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
     mesh_moved_.push_back(1);
     wall_force_N_.resize(walls_.size());

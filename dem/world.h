@@ -12,6 +12,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -226,6 +227,7 @@ private:
     std::vector<PlaneWall> planes_;
     std::vector<MeshWall> meshes_;
     std::vector<WallRef> walls_;
+    std::unordered_set<std::string> wall_names_;  ///< of walls_, for check_wall_name (a pile has 20,000 rocks)
     std::vector<WallMotion> wall_motion_;  ///< beside walls_, refreshed by compute_wall_contacts
     /// What the sphere pairs of a convex body read of it, in four cache lines (the geometry in the first two):
     /// the pairs meet their bodies in no order, so each is fetched ahead of its pair (compute_convex_contacts).

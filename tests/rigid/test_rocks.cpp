@@ -290,6 +290,30 @@ TEST_CASE("rock friction is the pair's coefficient, not Bullet's product: slidin
     }
 }
 
+TEST_CASE("rigid world: a missing material pair is found among new and old bodies alike", "[rigid][unit][bad_input]")
+{
+    // rock_world sets rock-rock and rock-ground; "ice" gets a pair with the ground only
+    RigidWorld w = rock_world(1e-3);
+    w.add_material("ice");
+    w.set_pair("ice", "ground", 0.1, 0.0);
+    w.add_ground_plane(0.0, w.material_index("ground"), "ground");
+    w.add_rock(cube(0.3), 2700.0, w.material_index("rock"), {0.0, 0.0, 1.0});
+    w.add_rock(cube(0.3), 900.0, w.material_index("ice"), {5.0, 0.0, 1.0});
+    // one ice rock: it meets the rock (ice-rock unset)
+    CHECK_THROWS_WITH(w.step(), (Catch::Contains("rock-ice") || Catch::Contains("ice-rock")) && Catch::Contains("set_pair"));
+    w.set_pair("ice", "rock", 0.2, 0.0);
+    w.step();  // one ice rock needs no ice-ice pair
+    // a second ice rock, new: the old one now meets an ice rock, and the error names both
+    w.add_rock(cube(0.3), 900.0, w.material_index("ice"), {10.0, 0.0, 1.0});
+    CHECK_THROWS_WITH(w.step(), Catch::Contains("ice-ice") && Catch::Contains("set_pair"));
+    w.set_pair("ice", "ice", 0.1, 0.0);
+    w.step();
+    // a body of an unpaired material added after the others were checked: the old rocks meet it
+    w.add_material("steel");
+    w.add_static_mesh(meshes::make_plate_mesh(1, 1, 1, 1), w.material_index("steel"), "late_plate");
+    CHECK_THROWS_WITH(w.step(), Catch::Contains("'late_plate'") && Catch::Contains("-steel"));
+}
+
 TEST_CASE("rigid world: bad input gives clear errors", "[rigid][unit][bad_input]")
 {
     RigidWorld w = rock_world(1e-3);
