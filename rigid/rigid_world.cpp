@@ -252,6 +252,11 @@ BodyState RigidWorld::state(BodyId id) const
     return {from_bt(t.getOrigin()), from_bt(t.getBasis()), from_bt(b->getLinearVelocity()), from_bt(b->getAngularVelocity())};
 }
 
+Vec3 RigidWorld::position_m(BodyId id) const
+{
+    return from_bt(impl_->body(id, "position_m").object()->getWorldTransform().getOrigin());
+}
+
 void RigidWorld::apply_force(BodyId id, const Vec3& force, const Vec3& point)
 {
     Impl::Body& b = impl_->body(id, "apply_force");

@@ -97,6 +97,8 @@ public:
     const std::string& body_name(BodyId body) const;
     double mass_kg(BodyId body) const;  ///< 0 for static and kinematic bodies
     BodyState state(BodyId body) const;
+    /// The body's centre of mass (a mesh's or link's origin), m: state()'s position without the rest.
+    Vec3 position_m(BodyId body) const;
     /// The collision margin a rock was given, m (0 for meshes and planes).
     double margin_m(BodyId body) const;
 

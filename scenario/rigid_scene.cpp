@@ -6,6 +6,7 @@
 #include "meshes/vtk_surface.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace dipper::scenario {
@@ -286,22 +287,32 @@ bool RigidScene::clear_of_machine(const Vec3& c, double r) const
 
 void RigidScene::check_tunnelling() const
 {
+    // one pass over the rocks for both parts: a pile has 20,000 rocks, and this runs after every coupling step
     if (!has_shovel() || coupled_->rocks().empty()) return;
+    struct Part {
+        Mat3 back;
+        Vec3 origin;
+        const std::vector<meshes::Plate>* plates;
+        Sphere bound;
+    };
+    std::array<Part, 2> parts;
     for (int part = 0; part < 2; ++part) {
         Mat3 r;
         Vec3 o;
         if (part == 0) rigid_->dipper_pose(r, o);
         else rigid_->door_pose(r, o);
-        const Mat3 back = r.transposed();
-        const std::vector<meshes::Plate>& plates = part == 0 ? dipper_.body.plates : dipper_.door.plates;
-        const Sphere& bound = part_bounds_[static_cast<std::size_t>(part)];
-        for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
-            const rigid::BodyId id = coupled_->rocks()[k].body;
-            const Vec3 c = rigid_->state(id).position_m;
-            const Vec3 q = back * (c - o);
-            if (norm_squared(q - bound.centre) > bound.radius * bound.radius) continue;  // far from every plate
-            for (std::size_t p = 0; p < plates.size(); ++p)
-                if (inside_plate(plates[p], q)) {
+        parts[static_cast<std::size_t>(part)] = {r.transposed(), o, part == 0 ? &dipper_.body.plates : &dipper_.door.plates,
+                                                 part_bounds_[static_cast<std::size_t>(part)]};
+    }
+    for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
+        const rigid::BodyId id = coupled_->rocks()[k].body;
+        const Vec3 c = rigid_->position_m(id);
+        for (std::size_t part = 0; part < parts.size(); ++part) {
+            const Part& pt = parts[part];
+            const Vec3 q = pt.back * (c - pt.origin);
+            if (norm_squared(q - pt.bound.centre) > pt.bound.radius * pt.bound.radius) continue;  // far from every plate
+            for (std::size_t p = 0; p < pt.plates->size(); ++p)
+                if (inside_plate((*pt.plates)[p], q)) {
                     const double dt = coupled_->dem_step_s();
                     throw SimulationError(concat(
                         "t = ", coupled_->time_s(), " s: rock ", k, " (", coupled_->rocks()[k].shape.equivalent_diameter_m(),
