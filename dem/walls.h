@@ -80,6 +80,10 @@ public:
     /// An upper bound on how far any vertex has moved from where the pose (rotation0, translation0) put it:
     /// |(R - R0) c + T - T0| + |R - R0|_2 rho, with c and rho a body-frame bounding sphere.
     double max_vertex_move_m(const Mat3& rotation0, const Vec3& translation0_m) const;
+    /// A sphere that holds the mesh: its centre in the body frame and at the current pose, and its radius.
+    const Vec3& bound_centre_body_m() const { return bound_centre_; }
+    Vec3 bound_centre_world_m() const { return to_world(bound_centre_); }
+    double bound_radius_m() const { return bound_radius_m_; }
     const Vec3& angular_velocity_rad_per_s() const { return angular_velocity_; }
     /// The point whose velocity set_pose gave (a rigid body's centre of mass), world frame.
     const Vec3& reference_point_m() const { return reference_point_; }
