@@ -138,11 +138,14 @@ void CoupledWorld::read_rocks(StateReader& in)
     in.tag("rocks");
     const auto n = in.value<std::uint64_t>();
     if (n > in.left()) in.fail("more rocks than the file holds");
-    // Each rock is made where it meets no other until read_state puts it in place: in a row with gaps, far
-    // below the scene. Made at one point, every two of them would overlap, and Bullet's broad phase would list
-    // each such pair as the rocks came in (2e8 pairs, minutes and gigabytes, for the thesis' pile of 20,000).
-    constexpr double kParkedDepth_m = -1.0e5, kParkedGap_m = 1.0;
-    double parked_x_m = 0.0;
+    struct Read {
+        rigid::ConvexPolyhedron shape;
+        double density;
+        int rigid_material;
+        dem::MaterialIndex dem_material;
+    };
+    std::vector<Read> read;
+    double reach_m = 0.0;  // of the largest rock, from its centroid
     for (std::uint64_t k = 0; k < n; ++k) {
         std::vector<Vec3> vertices;
         std::vector<std::array<std::uint32_t, 3>> triangles;
@@ -155,16 +158,24 @@ void CoupledWorld::read_rocks(StateReader& in)
             for (std::uint32_t v : t)
                 if (v >= vertices.size()) in.fail(concat("rock ", k, " has a triangle with vertex ", v, " of ", vertices.size()));
         try {
-            const rigid::ConvexPolyhedron shape =
-                rigid::ConvexPolyhedron::from_mesh(meshes::TriangleMesh(std::move(vertices), std::move(triangles), "checkpoint rock"));
-            double reach_m = 0.0;
-            for (const Vec3& v : shape.vertices_m()) reach_m = std::max(reach_m, norm(v));
-            parked_x_m += reach_m;
-            add_rock(shape, density, rigid_material, dem_material, {parked_x_m, 0.0, kParkedDepth_m});
-            parked_x_m += reach_m + kParkedGap_m;
+            read.push_back({rigid::ConvexPolyhedron::from_mesh(meshes::TriangleMesh(std::move(vertices), std::move(triangles), "checkpoint rock")),
+                            density, rigid_material, dem_material});
         } catch (const InputError& e) {
             in.fail(concat("rock ", k, ": ", e.what()));
         }
+        for (const Vec3& v : read.back().shape.vertices_m()) reach_m = std::max(reach_m, norm(v));
+    }
+    // Each rock is made where it meets no other until read_state puts it in place: on a cubic lattice with gaps,
+    // far below the scene. Made at one point, every two of them would overlap, and Bullet's broad phase would
+    // list each such pair as the rocks came in (2e8 pairs, minutes and gigabytes, for the thesis' pile of
+    // 20,000); made in a row, its tree of boxes would grow as deep as the row is long.
+    constexpr double kParkedDepth_m = -1.0e5, kParkedGap_m = 1.0;
+    const double spacing = 2.0 * reach_m + kParkedGap_m;
+    const auto side = static_cast<std::size_t>(std::ceil(std::cbrt(static_cast<double>(read.size())))) + 1;
+    for (std::size_t k = 0; k < read.size(); ++k) {
+        const Vec3 parked{spacing * static_cast<double>(k % side), spacing * static_cast<double>(k / side % side),
+                          kParkedDepth_m - spacing * static_cast<double>(k / (side * side))};
+        add_rock(read[k].shape, read[k].density, read[k].rigid_material, read[k].dem_material, parked);
     }
 }
 
