@@ -142,8 +142,8 @@ private:
 };
 
 /// The placed rocks by cells of a uniform grid: each rock is listed in every cell its bounding sphere's box
-/// meets, so two rocks whose bounding spheres overlap share a cell. Placing a pile of 20,000 rocks then costs
-/// the rocks near each try, not all of those placed before it.
+/// meets, so a rock or sphere whose bounding sphere overlaps a rock's shares a cell with it. Placing a pile of
+/// 20,000 rocks and 146,000 spheres then costs the rocks near each try, not all of those placed before it.
 class RockGrid {
 public:
     RockGrid(const Vec3& lo, double cell) : lo_(lo), cell_(cell) {}
@@ -288,18 +288,9 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
         }
     }
 
-    // spheres in the gaps; rocks found through a coarse grid of their bounding spheres
+    // spheres in the gaps; the rocks near each try found through the same grid
     const double sphere_mass = dem::sphere_mass_kg(rs, materials.density_kg_per_m3);
     const auto sphere_count = static_cast<std::size_t>(std::llround(distribution.sphere_mass_fraction * total_mass_kg / sphere_mass));
-    double rock_reach = 0.0;
-    for (const PlacedRock& p : placed) rock_reach = std::max(rock_reach, p.radius);
-    const double rock_cell = 2.0 * (rock_reach + rs);
-    std::unordered_map<std::int64_t, std::vector<std::uint32_t>> rock_cells;
-    auto key = [&](int i, int j, int k) { return (static_cast<std::int64_t>(i) * 100003 + j) * 100019 + k; };
-    auto cell_of = [&](double v, double base) { return static_cast<int>(std::floor((v - base) / rock_cell)); };
-    for (std::size_t p = 0; p < placed.size(); ++p)
-        rock_cells[key(cell_of(placed[p].centre.x, lo.x), cell_of(placed[p].centre.y, lo.y), cell_of(placed[p].centre.z, lo.z))]
-            .push_back(static_cast<std::uint32_t>(p));
     const Vec3 s_lo = lo + Vec3{rs, rs, rs}, s_hi = hi - Vec3{rs, rs, rs};
     if (s_lo.x > s_hi.x || s_lo.y > s_hi.y || s_lo.z > s_hi.z)
         throw InputError(concat(where, ": the box is thinner than one sphere of radius ", rs, " m"));
@@ -308,17 +299,7 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
         for (int attempt = 0; attempt < attempts && !done; ++attempt) {
             const Vec3 x{s_lo.x + u(rng) * (s_hi.x - s_lo.x), s_lo.y + u(rng) * (s_hi.y - s_lo.y), s_lo.z + u(rng) * (s_hi.z - s_lo.z)};
             if (!grid.free(x, rs) || (keep && !keep(x, rs))) continue;
-            bool clear = true;
-            const int ci = cell_of(x.x, lo.x), cj = cell_of(x.y, lo.y), ck = cell_of(x.z, lo.z);
-            for (int dk = -1; dk <= 1 && clear; ++dk)
-                for (int dj = -1; dj <= 1 && clear; ++dj)
-                    for (int di = -1; di <= 1 && clear; ++di) {
-                        const auto it = rock_cells.find(key(ci + di, cj + dj, ck + dk));
-                        if (it == rock_cells.end()) continue;
-                        for (std::uint32_t p : it->second)
-                            if (!sphere_clear_of(placed[p], x, rs)) { clear = false; break; }
-                    }
-            if (!clear) continue;
+            if (!placed_grid.all_of_near(x, rs, [&](std::uint32_t q) { return sphere_clear_of(placed[q], x, rs); })) continue;
             dem.add_particle({x, {}, {}, rs, materials.sphere}, where);
             grid.add(x, rs);
             report.sphere_mass_kg += sphere_mass;

@@ -629,8 +629,8 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     // Triangles into every cell their inflated bounding box overlaps; a convex body (a rock) as a whole, by its
     // bounding sphere, into every cell that sphere's inflated box overlaps, for its particles to test all its
     // faces (a triangle within reach of a centre is within reach of the sphere, so the candidates are the same,
-    // in the same order). A pile of 20,000 rocks of 36 faces each then puts some 20,000 bodies into the cells
-    // on one thread instead of 720,000 triangles, and needs none of their vertices in the world frame.
+    // in the same order). The thesis' pile then puts its 20,188 rocks into the cells on one thread instead of
+    // their 645,464 triangles, and needs none of their vertices in the world frame.
     constexpr std::uint32_t kWholeMesh = kPlaneCandidate - 1;
     const std::size_t cell_count = cell_start.size() - 1;
     // the large lists live in scratch_ from rebuild to rebuild: fresh ones of some megabytes would be mapped
