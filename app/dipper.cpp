@@ -2,7 +2,7 @@
 //
 //   dipper run FILE [--out DIR] [--threads N] [--stop-after S] [--quiet]
 //   dipper check FILE...
-//   dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]
+//   dipper resume DIR [--from CHECKPOINT] [--threads N] [--stop-after S] [--quiet]
 //   dipper sweep FILE [--out DIR] [--threads N] [--quiet]     (under mpirun: variants spread over ranks)
 //   dipper report DIR      (report.md and PNG figures from summary.json and probes.csv)
 //   dipper keys            (every scenario key as a Markdown table)
@@ -18,6 +18,7 @@
 #include <mpi.h>
 #endif
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -35,7 +36,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: dipper run FILE [--out DIR] [--threads N] [--stop-after SECONDS] [--quiet]\n"
     "       dipper check FILE...   (scenario or sweep files)\n"
-    "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--quiet]\n"
+    "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--stop-after SECONDS] [--quiet]\n"
     "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
     "       dipper calibrate repose FILE [--target DEG] [--tolerance DEG] [--pair A,B] [--rolling R1,R2,...]\n"
     "                              [--seeds N] [--out DIR] [--threads N] [--quiet]\n"
@@ -64,11 +65,28 @@ double number_option(const std::string& option, const std::string& v)
     return x;
 }
 
-Options parse_options(int argc, char** argv, int first)
+/// The options each command takes (as the usage lists them); any other is an error, not ignored.
+std::vector<std::string> options_of(const std::string& command)
+{
+    if (command == "run") return {"--out", "--threads", "--stop-after", "--quiet"};
+    if (command == "resume") return {"--from", "--threads", "--stop-after", "--quiet"};
+    if (command == "sweep") return {"--out", "--threads", "--quiet"};
+    if (command == "calibrate")
+        return {"--target", "--tolerance", "--pair", "--rolling", "--seeds", "--out", "--threads", "--quiet"};
+    return {};
+}
+
+Options parse_options(int argc, char** argv, int first, const std::string& command)
 {
     Options o;
+    const std::vector<std::string> allowed = options_of(command);
     for (int a = first; a < argc; ++a) {
         const std::string arg = argv[a];
+        if (!arg.empty() && arg[0] == '-' && std::find(allowed.begin(), allowed.end(), arg) == allowed.end()) {
+            std::string takes;
+            for (const std::string& option : allowed) takes += (takes.empty() ? "" : ", ") + option;
+            usage(concat(command, " does not take ", arg, "; it takes ", takes.empty() ? "no options" : takes));
+        }
         const auto value = [&]() -> std::string {
             if (a + 1 >= argc) usage(arg + " needs a value");
             return argv[++a];
@@ -230,8 +248,13 @@ int main(int argc, char** argv)
         return 0;
     }
     try {
-        if (command == "keys") return print_keys();
-        const Options o = parse_options(argc, argv, 2);
+        if (command == "keys") {
+            if (argc > 2) usage(concat("keys takes no arguments; got '", argv[2], "'"));
+            return print_keys();
+        }
+        const std::vector<std::string> commands{"check", "run", "resume", "sweep", "calibrate", "report"};
+        if (std::find(commands.begin(), commands.end(), command) == commands.end()) usage("unknown command '" + command + "'");
+        const Options o = parse_options(argc, argv, 2, command);
         if (command == "check") {
             if (o.positional.empty()) usage("check needs at least one scenario file");
             for (const std::string& file : o.positional) {
