@@ -685,16 +685,19 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     }
 
     // each particle keeps the planes, then the triangles of its own cell, that lie within r + skin
-    auto& per_thread = scratch_.per_thread;
-    per_thread.resize(static_cast<std::size_t>(threads_));
+    // In blocks of particles handed out as threads come free and joined in block order: the cells of a bed's
+    // bottom or a pile's rocks hold most of the candidates, so equal halves of the particles are far from equal
+    // work (in the thesis' settling column the first of two threads took half as long again as the second).
+    auto& per_block = scratch_.per_block;
+    const int blocks = threads_ == 1 ? 1 : 16 * threads_;
+    per_block.resize(static_cast<std::size_t>(blocks));
     std::vector<std::uint32_t> counts(n, 0);
-#pragma omp parallel num_threads(threads_)
-    {
-        const int t = omp_get_thread_num();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
+    for (int b = 0; b < blocks; ++b) {
         std::size_t begin, end;
-        thread_block(n, t, threads_, begin, end);
-        std::vector<MeshCandidate> out = std::move(per_thread[static_cast<std::size_t>(t)]);  // a local, moved back at
-        out.clear();                                                                          // the end (the headers share a cache line)
+        thread_block(n, b, blocks, begin, end);
+        std::vector<MeshCandidate> out = std::move(per_block[static_cast<std::size_t>(b)]);  // a local, moved back at
+        out.clear();                                                                         // the end (the headers share a cache line)
         for (std::size_t i = begin; i < end; ++i) {
             const Vec3 p = particles_.position_m[i];
             int c[3];
@@ -737,10 +740,10 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
                 }
             }
         }
-        per_thread[static_cast<std::size_t>(t)] = std::move(out);
+        per_block[static_cast<std::size_t>(b)] = std::move(out);
     }
     for (std::size_t i = 0; i < n; ++i) candidate_start_[i + 1] = candidate_start_[i] + counts[i];
-    for (const auto& v : per_thread) candidates_.insert(candidates_.end(), v.begin(), v.end());
+    for (const auto& v : per_block) candidates_.insert(candidates_.end(), v.begin(), v.end());
     split_candidates();
 }
 
@@ -782,20 +785,29 @@ void World::split_candidates()
     }
     convex_thread_start_[static_cast<std::size_t>(threads_)] = convex_pairs_.size();
 
-    // the faces beside the pairs, in pair order
-    convex_faces_.clear();
-    convex_face_triangle_.clear();
-    for (ConvexPair& p : convex_pairs_) {
-        const auto at = static_cast<std::uint32_t>(convex_faces_.size());
-        for (std::uint32_t k = p.face_begin; k < p.face_end; ++k) {
-            convex_faces_.push_back(meshes_[p.mesh].packed_body(candidates_[k].triangle));
-            convex_face_triangle_.push_back(static_cast<std::int32_t>(candidates_[k].triangle));
-        }
-        p.face_end = at + (p.face_end - p.face_begin);
-        p.face_begin = at;
+    // the faces beside the pairs, in pair order, and the face across each edge of each: every pair's on its own
+    // (at full size, about 10^5 pairs per rebuild)
+    const auto pair_count = static_cast<std::ptrdiff_t>(convex_pairs_.size());
+    std::vector<std::uint32_t> first_candidate(convex_pairs_.size());
+    std::uint32_t faces = 0;
+    for (std::size_t q = 0; q < convex_pairs_.size(); ++q) {
+        ConvexPair& p = convex_pairs_[q];
+        first_candidate[q] = p.face_begin;
+        p.face_end = faces + (p.face_end - p.face_begin);
+        p.face_begin = faces;
+        faces = p.face_end;
     }
-    convex_face_across_.resize(convex_faces_.size());
-    for (const ConvexPair& p : convex_pairs_)
+    convex_faces_.resize(faces);
+    convex_face_triangle_.resize(faces);
+    convex_face_across_.resize(faces);
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (std::ptrdiff_t q = 0; q < pair_count; ++q) {
+        const ConvexPair& p = convex_pairs_[static_cast<std::size_t>(q)];
+        for (std::uint32_t f = p.face_begin; f < p.face_end; ++f) {
+            const std::uint32_t triangle = candidates_[first_candidate[static_cast<std::size_t>(q)] + (f - p.face_begin)].triangle;
+            convex_faces_[f] = meshes_[p.mesh].packed_body(triangle);
+            convex_face_triangle_[f] = static_cast<std::int32_t>(triangle);
+        }
         for (std::uint32_t f = p.face_begin; f < p.face_end; ++f)
             for (int k = 0; k < 3; ++k) {
                 const auto [e0, e1] = edge_ends(convex_faces_[f], k);
@@ -813,10 +825,12 @@ void World::split_candidates()
                     break;
                 }
             }
+    }
     // a pair's contact is read only while it touches, so the contacts need no clearing
     convex_contacts_.resize(convex_pairs_.size());
     convex_touching_.assign(convex_pairs_.size(), 0);
     convex_push_.assign(convex_pairs_.size(), Push{});
+    convex_reaction_.resize(convex_pairs_.size());
     convex_contact_count_ = 0;
     convex_pair_start_.assign(n + 1, 0);
     for (const ConvexPair& p : convex_pairs_) ++convex_pair_start_[p.particle + 1];
@@ -875,6 +889,22 @@ void World::split_convex_contacts()
     wall_contact_start_.assign(n + 1, 0);
     for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
     std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
+
+    // The pairs' contacts are shared out by their cost, not by the particles' blocks: those are equal in
+    // particles, and a settling column's lower half holds most of the pairs (in the thesis' calibration pile the
+    // first of two threads took six times the second's share). A pair touching at the rebuild (closest point,
+    // law and contact record) weighs as three apart: in that pile, at 1 s, weights of 1 and 4 left the first
+    // thread's pass 1.45 and 0.88 times as long as the second's.
+    constexpr std::size_t kTouchingWeight = 3;
+    std::size_t total = 0;
+    for (std::uint8_t touching : convex_touching_) total += touching ? kTouchingWeight : 1;
+    convex_pass_start_.assign(static_cast<std::size_t>(threads_) + 1, convex_pairs_.size());
+    convex_pass_start_[0] = 0;
+    std::size_t sum = 0, t = 1;
+    for (std::size_t k = 0; k < convex_pairs_.size() && t < static_cast<std::size_t>(threads_); ++k) {
+        while (t < static_cast<std::size_t>(threads_) && sum >= total * t / static_cast<std::size_t>(threads_)) convex_pass_start_[t++] = k;
+        sum += convex_touching_[k] ? kTouchingWeight : 1;
+    }
 }
 
 std::vector<World::WallContact> World::merged_wall_contacts() const
@@ -1184,8 +1214,7 @@ bool World::edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::
     return true;
 }
 
-std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, Vec3* __restrict wall_force,
-                                           Vec3* __restrict wall_torque, std::size_t& first_deep)
+std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep)
 {
     // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in front of one
     // of the faces within reach touches none of them. A centre in front of some face lies outside, and the hull's
@@ -1300,11 +1329,9 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         c.relative_displacement_m = relative_velocity * dt_s;
         const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
         convex_push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
-        // the body's reaction, while the contact is in cache (a body's sum holds only its own pairs, in order)
-        const auto w_id = static_cast<std::size_t>(c.wall);
+        // the body's reaction, while the contact is in cache (summed per body after all pairs are done)
         const Vec3 on_wall = -force;
-        wall_force[w_id] += on_wall;
-        wall_torque[w_id] += cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
+        convex_reaction_[k] = {on_wall, cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m};
         if (first_deep == kNoContact && c.overlap_m / r > settings_.max_overlap_ratio) first_deep = k;
     }
     return touching;
@@ -1375,8 +1402,8 @@ void World::compute_wall_contacts(double dt_s)
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         wall_thread_block(t, begin, end);
-        // the thread's share of each wall's reaction: a convex body's from its pairs below, the others' from
-        // the thread's contacts after the barrier (no wall has both)
+        // the thread's share of each wall's reaction, summed after the barrier: a convex body's from the pairs of
+        // the thread's particles, the others' from the thread's contacts (no wall has both)
         Vec3* __restrict wall_force = thread_wall_force_N_[static_cast<std::size_t>(t)].data();
         Vec3* __restrict wall_torque = thread_wall_torque_N_m_[static_cast<std::size_t>(t)].data();
         std::fill(wall_force, wall_force + walls_.size(), Vec3{});
@@ -1392,11 +1419,10 @@ void World::compute_wall_contacts(double dt_s)
             for (auto i = first; i != last; ++i) find_wall_contacts(*i, dt_s, hits, out);
         }
         // the spheres near convex bodies, in particle order: each pair's contact in its place
-        const std::size_t pair_begin = convex_thread_start_[static_cast<std::size_t>(t)];
-        const std::size_t pair_end = convex_thread_start_[static_cast<std::size_t>(t) + 1];
         std::size_t first_deep_convex = kNoContact;
         auto convex_start = std::chrono::steady_clock::now();
-        convex_touching += compute_convex_contacts(pair_begin, pair_end, dt_s, wall_force, wall_torque, first_deep_convex);
+        convex_touching += compute_convex_contacts(convex_pass_start_[static_cast<std::size_t>(t)],
+                                                   convex_pass_start_[static_cast<std::size_t>(t) + 1], dt_s, first_deep_convex);
         thread_convex_seconds_[static_cast<std::size_t>(t)] = seconds_since(convex_start);
         thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
 
@@ -1443,6 +1469,17 @@ void World::compute_wall_contacts(double dt_s)
                 first_deep = offset + q;
         }
         thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
+
+        // the convex bodies' reactions: the pairs of the thread's particles, in order (the same sums whichever
+        // thread computed the contacts)
+        convex_start = std::chrono::steady_clock::now();
+        for (std::size_t q = convex_thread_start_[static_cast<std::size_t>(t)]; q < convex_thread_start_[static_cast<std::size_t>(t) + 1]; ++q) {
+            if (!convex_touching_[q]) continue;
+            const auto w = static_cast<std::size_t>(mesh_wall_id_[convex_pairs_[q].mesh]);
+            wall_force[w] += convex_reaction_[q].force_N;
+            wall_torque[w] += convex_reaction_[q].torque_N_m;
+        }
+        thread_convex_seconds_[static_cast<std::size_t>(t)] += seconds_since(convex_start);
     }
     convex_contact_count_ = convex_touching;
     phase_seconds_.convex_forces += *std::max_element(thread_convex_seconds_.begin(), thread_convex_seconds_.end());

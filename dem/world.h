@@ -200,11 +200,9 @@ private:
     void split_convex_contacts();
     /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
     std::vector<WallContact> merged_wall_contacts() const;
-    /// The contacts of convex pairs begin..end-1; returns how many touch.
-    /// The contacts of convex pairs [begin, end), with their bodies' reactions added to wall_force and
-    /// wall_torque and the first pair past the overlap limit in first_deep; returns how many touch.
-    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, Vec3* __restrict wall_force,
-                                        Vec3* __restrict wall_torque, std::size_t& first_deep);
+    /// The contacts of convex pairs [begin, end), with each touching pair's reaction on its body in
+    /// convex_reaction_ and the first pair past the overlap limit in first_deep; returns how many touch.
+    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep);
     /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
     void apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const;
     void evaluate_forces(double dt_s, double half_kick_s);
@@ -301,8 +299,13 @@ private:
     std::vector<std::uint8_t> convex_touching_;      ///< beside convex_pairs_
     struct Push { Vec3 force_N, torque_N_m; };       ///< on the particle, about its centre
     std::vector<Push> convex_push_;                  ///< beside convex_pairs_ (zero when apart)
+    /// beside convex_pairs_, read only while touching: the pair's reaction on its body (about the body's reference point)
+    std::vector<Push> convex_reaction_;
     std::vector<std::uint32_t> convex_pair_start_, convex_pair_index_;  ///< each particle's pairs
-    std::vector<std::size_t> convex_thread_start_;   ///< the pairs of each thread (those of its particles)
+    /// The pairs of each thread's particles: the thread sums their reactions on the bodies in this order, so that a
+    /// body's reaction is the same sum for a thread count however the pairs' contacts were shared out.
+    std::vector<std::size_t> convex_thread_start_;
+    std::vector<std::size_t> convex_pass_start_;     ///< the pairs whose contacts each thread computes: equal shares
     std::size_t convex_contact_count_ = 0;
     std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit
     std::vector<double> thread_convex_seconds_;           ///< per thread: its pass over its convex pairs, this step
@@ -310,7 +313,7 @@ private:
     struct CandidateScratch {
         std::vector<std::pair<std::uint32_t, MeshCandidate>> entries;  ///< (cell, triangle)
         std::vector<MeshCandidate> bucket;                             ///< triangles by cell
-        std::vector<std::vector<MeshCandidate>> per_thread;
+        std::vector<std::vector<MeshCandidate>> per_block;
     } scratch_;
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
