@@ -684,10 +684,10 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
         for (const auto& e : entries) bucket[fill[e.first]++] = e.second;
     }
 
-    // each particle keeps the planes, then the triangles of its own cell, that lie within r + skin
-    // In blocks of particles handed out as threads come free and joined in block order: the cells of a bed's
-    // bottom or a pile's rocks hold most of the candidates, so equal halves of the particles are far from equal
-    // work (in the thesis' settling column the first of two threads took half as long again as the second).
+    // Each particle keeps the planes, then the triangles of its own cell, that lie within r + skin. The particles
+    // go in blocks handed out as threads come free, joined in block order: the cells of a bed's bottom or of a
+    // pile's rocks hold most of the candidates, so equal halves of the particles are far from equal work (in the
+    // thesis' settling column the first of two threads took nearly twice as long as the second).
     auto& per_block = scratch_.per_block;
     const int blocks = threads_ == 1 ? 1 : 16 * threads_;
     per_block.resize(static_cast<std::size_t>(blocks));

@@ -305,7 +305,7 @@ private:
     /// The pairs of each thread's particles: the thread sums their reactions on the bodies in this order, so that a
     /// body's reaction is the same sum for a thread count however the pairs' contacts were shared out.
     std::vector<std::size_t> convex_thread_start_;
-    std::vector<std::size_t> convex_pass_start_;     ///< the pairs whose contacts each thread computes: equal shares
+    std::vector<std::size_t> convex_pass_start_;     ///< the pairs whose contacts each thread computes: shares of equal cost
     std::size_t convex_contact_count_ = 0;
     std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit
     std::vector<double> thread_convex_seconds_;           ///< per thread: its pass over its convex pairs, this step
