@@ -206,6 +206,9 @@ public:
         const auto reached = [&](double t) { return world_->time_s() >= t - 1e-6 * dt; };
         // a shovel run may end after a number of passes: 1 s after the last one's door opened
         const std::size_t passes = scenario_.shovel ? static_cast<std::size_t>(scenario_.shovel->passes) : 0;
+        if (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))
+            throw InputError(concat("--stop-after ", options_.stop_after_s, " s: the run is already at t = ", world_->time_s(),
+                                    " s; give a later time"));
         try {
             while (!reached(end_s)) {
                 const std::uint64_t before = world_->step_count();
