@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -65,21 +66,24 @@ double number_option(const std::string& option, const std::string& v)
     return x;
 }
 
-/// The options each command takes (as the usage lists them); any other is an error, not ignored.
-std::vector<std::string> options_of(const std::string& command)
+/// The commands that read options, and the options each takes (as the usage lists them); any other is an error,
+/// not ignored.
+const std::map<std::string, std::vector<std::string>>& command_options()
 {
-    if (command == "run") return {"--out", "--threads", "--stop-after", "--quiet"};
-    if (command == "resume") return {"--from", "--threads", "--stop-after", "--quiet"};
-    if (command == "sweep") return {"--out", "--threads", "--quiet"};
-    if (command == "calibrate")
-        return {"--target", "--tolerance", "--pair", "--rolling", "--seeds", "--out", "--threads", "--quiet"};
-    return {};
+    static const std::map<std::string, std::vector<std::string>> table{
+        {"check", {}},
+        {"run", {"--out", "--threads", "--stop-after", "--quiet"}},
+        {"resume", {"--from", "--threads", "--stop-after", "--quiet"}},
+        {"sweep", {"--out", "--threads", "--quiet"}},
+        {"calibrate", {"--target", "--tolerance", "--pair", "--rolling", "--seeds", "--out", "--threads", "--quiet"}},
+        {"report", {}}};
+    return table;
 }
 
 Options parse_options(int argc, char** argv, int first, const std::string& command)
 {
     Options o;
-    const std::vector<std::string> allowed = options_of(command);
+    const std::vector<std::string>& allowed = command_options().at(command);
     for (int a = first; a < argc; ++a) {
         const std::string arg = argv[a];
         if (!arg.empty() && arg[0] == '-' && std::find(allowed.begin(), allowed.end(), arg) == allowed.end()) {
@@ -252,8 +256,7 @@ int main(int argc, char** argv)
             if (argc > 2) usage(concat("keys takes no arguments; got '", argv[2], "'"));
             return print_keys();
         }
-        const std::vector<std::string> commands{"check", "run", "resume", "sweep", "calibrate", "report"};
-        if (std::find(commands.begin(), commands.end(), command) == commands.end()) usage("unknown command '" + command + "'");
+        if (command_options().count(command) == 0) usage("unknown command '" + command + "'");
         const Options o = parse_options(argc, argv, 2, command);
         if (command == "check") {
             if (o.positional.empty()) usage("check needs at least one scenario file");
