@@ -206,6 +206,9 @@ double World::reference_step_s() const
 
 double World::step_s() const
 {
+    // resolved by validate_step, which runs again after any particle, wall or material is added (the
+    // default is a minimum over the particles: at full size 146,000 square roots per call)
+    if (step_checked_) return step_s_;
     if (settings_.step_s > 0.0) return settings_.step_s;
     return kDefaultStepFactor * reference_step_s();
 }
@@ -366,8 +369,12 @@ bool World::needs_rebuild(double particle_move_m) const
 {
     if (2.0 * particle_move_m > skin_m_) return true;
 
+    // every rock is a mesh: at full size 20,000 of them, read on all threads (a maximum: the same in any order)
     double mesh_move = 0.0;
-    for (std::size_t m = 0; m < meshes_.size(); ++m) {
+    const auto mesh_count = static_cast<std::ptrdiff_t>(meshes_.size());
+#pragma omp parallel for schedule(static) reduction(max : mesh_move) num_threads(threads_) if (mesh_count > 2048)
+    for (std::ptrdiff_t q = 0; q < mesh_count; ++q) {
+        const auto m = static_cast<std::size_t>(q);
         if (meshes_[m].pose_version() == reference_mesh_version_[m]) continue;  // not moved since the rebuild
         mesh_move = std::max(mesh_move, meshes_[m].max_vertex_move_m(reference_mesh_rotation_[m], reference_mesh_translation_m_[m]));
     }
