@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "core/files.h"
+#include "dem/insertion.h"
 #include "dem/particle_store.h"
 #include "rigid/rock_generator.h"
 
@@ -206,6 +207,16 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
     require_positive(materials.density_kg_per_m3, "density_kg_per_m3", where);
     for (int a = 0; a < 3; ++a)
         if (!(hi[a] > lo[a])) throw InputError(concat(where, ": box corner hi must exceed lo on every axis"));
+    dem::require_mass_fits(total_mass_kg, materials.density_kg_per_m3, lo, hi, where);
+    {
+        const double sphere_m3 = M_PI / 6.0 * 8.0 * distribution.sphere_radius_m * distribution.sphere_radius_m * distribution.sphere_radius_m;
+        double count = distribution.sphere_mass_fraction * total_mass_kg / materials.density_kg_per_m3 / sphere_m3;
+        for (const RockClass& rc : distribution.rocks)
+            count += rc.mass_fraction * total_mass_kg / materials.density_kg_per_m3 / (M_PI / 6.0 * rc.size_m * rc.size_m * rc.size_m);
+        if (!(count <= dem::kMaxFillParticles))
+            throw InputError(concat(where, ": ", total_mass_kg, " kg of this mix makes ", count, " spheres and rocks; at most ",
+                                    dem::kMaxFillParticles, " are made at once: check the mass and the sizes"));
+    }
     dem::World& dem = world.dem();
     const double sphere_density = dem.materials().material(materials.sphere).density_kg_per_m3;
     if (std::abs(sphere_density - materials.density_kg_per_m3) > 1e-9 * materials.density_kg_per_m3)

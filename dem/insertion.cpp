@@ -94,6 +94,13 @@ double SizeDistribution::max_radius_m() const
     return r;
 }
 
+double particles_for_mass(const SizeDistribution& distribution, double density, double total_mass_kg)
+{
+    double count = 0.0;
+    for (const SizeClass& c : distribution.classes) count += c.mass_fraction * total_mass_kg / sphere_mass_kg(c.radius_m, density);
+    return count;
+}
+
 std::vector<double> radii_for_mass(const SizeDistribution& distribution, double density, double total_mass_kg)
 {
     distribution.validate("radii_for_mass");
@@ -101,6 +108,11 @@ std::vector<double> radii_for_mass(const SizeDistribution& distribution, double 
     require_positive(total_mass_kg, "total_mass_kg", "radii_for_mass");
     std::vector<SizeClass> sorted = distribution.classes;
     std::sort(sorted.begin(), sorted.end(), [](const SizeClass& a, const SizeClass& b) { return a.radius_m > b.radius_m; });
+    const double total_count = particles_for_mass(distribution, density, total_mass_kg);
+    if (!(total_count <= kMaxFillParticles))
+        throw InputError(concat(total_mass_kg, " kg of these sizes (the smallest of radius ", sorted.back().radius_m, " m) at ",
+                                density, " kg/m3 makes ", total_count, " particles; at most ", kMaxFillParticles,
+                                " are made at once: check the mass and the radii"));
     std::vector<double> radii;
     for (const SizeClass& c : sorted) {
         const double m = sphere_mass_kg(c.radius_m, density);
@@ -108,6 +120,19 @@ std::vector<double> radii_for_mass(const SizeDistribution& distribution, double 
         radii.insert(radii.end(), count, c.radius_m);
     }
     return radii;
+}
+
+void require_mass_fits(double total_mass_kg, double density_kg_per_m3, const Vec3& lo, const Vec3& hi, const std::string& where)
+{
+    constexpr double kDensestPacking = 0.7405;  // pi / sqrt(18), face-centred cubic
+    const Vec3 size = hi - lo;
+    const double box_m3 = size.x * size.y * size.z;
+    const double solid_m3 = total_mass_kg / density_kg_per_m3;
+    if (solid_m3 > kDensestPacking * box_m3)
+        throw InputError(concat(where, ": ", total_mass_kg, " kg at ", density_kg_per_m3, " kg/m3 is ", solid_m3,
+                                " m3 of solid, more than the box of ", box_m3, " m3 holds even at the densest packing of spheres (",
+                                kDensestPacking * box_m3 * density_kg_per_m3, " kg, 74 % solid); a random fill places about half that: ",
+                                "make the box larger or the mass smaller"));
 }
 
 BoxRegion::BoxRegion(const Vec3& lo, const Vec3& hi) : lo_(lo), hi_(hi)
@@ -127,9 +152,10 @@ FillReport fill_random(World& world, const Region& region, const SizeDistributio
 {
     if (material >= world.materials().size() || world.materials().material(material).is_surface)
         throw InputError(concat("fill_random: material index ", material, " is not a particle material"));
-    const std::vector<double> radii =
-        radii_for_mass(distribution, world.materials().material(material).density_kg_per_m3, total_mass_kg);
+    const double density = world.materials().material(material).density_kg_per_m3;
     const Vec3 lo = region.bounds_min_m(), hi = region.bounds_max_m();
+    require_mass_fits(total_mass_kg, density, lo, hi, "fill_random");
+    const std::vector<double> radii = radii_for_mass(distribution, density, total_mass_kg);
     const double r_max = distribution.max_radius_m();
     SphereHash hash = hash_of_existing(world, lo, hi, 2.0 * r_max);
     hash.set_max_radius(r_max);

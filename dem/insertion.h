@@ -26,8 +26,17 @@ struct SizeDistribution {
 };
 
 /// Radii of the particles that make up `total_mass_kg` of a distribution at a density, largest first:
-/// class c gets round(fraction_c * total / m_c) particles.
+/// class c gets round(fraction_c * total / m_c) particles. More than kMaxFillParticles is an InputError
+/// that gives the count (a typo in a mass or a radius would otherwise exhaust the memory).
 std::vector<double> radii_for_mass(const SizeDistribution& distribution, double density_kg_per_m3, double total_mass_kg);
+constexpr double kMaxFillParticles = 1e8;
+/// How many particles radii_for_mass makes, before rounding (any size: nothing is allocated).
+double particles_for_mass(const SizeDistribution& distribution, double density_kg_per_m3, double total_mass_kg);
+
+/// Throws InputError naming `where` when `total_mass_kg` of solid at the density fills more than 74 % of the
+/// box [lo, hi] (the densest packing of equal spheres): such a fill cannot be placed, and finding that out by
+/// placing particles until one finds no room could take hours.
+void require_mass_fits(double total_mass_kg, double density_kg_per_m3, const Vec3& lo, const Vec3& hi, const std::string& where);
 
 /// Where particles may be placed: a whole sphere must fit.
 class Region {

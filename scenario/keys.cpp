@@ -69,7 +69,7 @@ const std::vector<KeySpec>& scenario_keys()
          "before the fills"},
         {"fills", "list", "[]", "particles placed at t = 0, seeded random and non-overlapping"},
         {"fills[].material", "string", "ore", "particle material"},
-        {"fills[].mass_kg", "number", "required", "total mass to place"},
+        {"fills[].mass_kg", "number", "required", "total mass to place: at most 74 % of the box as solid, and 10^8 spheres"},
         {"fills[].box", "map", "required", "the region: an axis-aligned box a whole sphere must fit in"},
         {"fills[].box.min_m", "vector3", "required", "lower corner"},
         {"fills[].box.max_m", "vector3", "required", "upper corner"},
@@ -87,7 +87,7 @@ const std::vector<KeySpec>& scenario_keys()
 
         {"pours", "list", "[]", "particles entering from a box at a mass flow rate"},
         {"pours[].material", "string", "ore", "particle material"},
-        {"pours[].mass_kg", "number", "required", "total mass to pour"},
+        {"pours[].mass_kg", "number", "required", "total mass to pour: at most 10^8 spheres"},
         {"pours[].rate_kg_per_s", "number", "required", "mass flow rate"},
         {"pours[].velocity_m_per_s", "vector3", "[0, 0, 0]", "velocity of entering particles"},
         {"pours[].start_s", "number", "0", "time the pour begins (one loader bucket after another)"},

@@ -358,6 +358,17 @@ std::string material_known(const Scenario& s, const MapReader& r, const std::str
     r.fail(key, concat("\"", name, "\""), concat("one of the ", surface ? "surface" : "particle", " materials: ", joined(names)));
 }
 
+/// A fill or pour of spheres alone makes at most dem::kMaxFillParticles (a mix with rocks is checked as it is made).
+void require_particle_count(const Scenario& s, const MapReader& r, const ParticleSource& source)
+{
+    const double density = s.materials.material(s.materials.index_of(source.material)).density_kg_per_m3;
+    const double count = dem::particles_for_mass(source.sizes, density, source.mass_kg);
+    if (!(count <= dem::kMaxFillParticles))
+        r.fail("mass_kg", concat(source.mass_kg),
+               concat("a mass of at most ", dem::kMaxFillParticles, " particles (this is ", count, " of these sizes at ",
+                      density, " kg/m3)"));
+}
+
 /// The keys fills and pours share: material, mass, box and sizes.
 ParticleSource read_source(const Scenario& s, const MapReader& r, bool fractions_sum_to_one = true)
 {
@@ -376,6 +387,9 @@ FillSpec read_fill(const Scenario& s, const MapReader& r)
     FillSpec fill;
     const std::vector<MapReader> rocks = r.maps("rocks");
     static_cast<ParticleSource&>(fill) = read_source(s, r, rocks.empty());
+    dem::require_mass_fits(fill.mass_kg, s.materials.material(s.materials.index_of(fill.material)).density_kg_per_m3,
+                           fill.min_m, fill.max_m, r.where("mass_kg"));
+    if (rocks.empty()) require_particle_count(s, r, fill);
     fill.rock_elongation_max = r.number("rock_elongation_max");
     require_in_range(fill.rock_elongation_max, 1.0, 4.0, "rock_elongation_max", r.where("rock_elongation_max"));
     const std::int64_t rock_points = r.integer("rock_points");
@@ -533,6 +547,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     for (const MapReader& p : top.maps("pours")) {
         PourSpec pour;
         static_cast<ParticleSource&>(pour) = read_source(s, p);
+        require_particle_count(s, p, pour);
         pour.rate_kg_per_s = p.number("rate_kg_per_s");
         require_positive(pour.rate_kg_per_s, "rate_kg_per_s", p.where("rate_kg_per_s"));
         pour.velocity_m_per_s = p.vector3("velocity_m_per_s");

@@ -160,8 +160,13 @@ TEST_CASE("mixed bed bad input: fractions, a box too small, corrupt state files"
     bad.sphere_mass_fraction = 0.5;
     CHECK_THROWS_WITH(coupling::fill_mixed(s->world, {0, 0, 0}, {2, 2, 2}, bad, table1_materials(*s), 1000.0, 1),
                       Catch::Contains("sum to 1.13") && Catch::Contains("expected 1"));
+    // 20 t is 5.4 m3 of solid: refused before any try, as more than even the densest packing puts in 1 m3
     CHECK_THROWS_WITH(coupling::fill_mixed(s->world, {0, 0, 0}, {1, 1, 1}, coupling::MixedDistribution::thesis_table1(),
                                            table1_materials(*s), 20000.0, 1, 200),
+                      Catch::Contains("more than the box of 1 m3 holds even at the densest packing"));
+    // 1.5 t is 0.41 m3 of solid, below that limit, but the 850 mm rocks find no place in a 1 m box
+    CHECK_THROWS_WITH(coupling::fill_mixed(s->world, {0, 0, 0}, {1, 1, 1}, coupling::MixedDistribution::thesis_table1(),
+                                           table1_materials(*s), 1500.0, 1, 200),
                       Catch::Contains("too small"));
     const std::string path = "corrupt_state.txt";
     {

@@ -60,10 +60,23 @@ TEST_CASE("random fill of a region bounded by a mesh keeps every sphere inside",
 TEST_CASE("a fill that cannot fit says so", "[dem][insertion][unit]")
 {
     World w(MaterialTable::aitik_copper_ore(), WorldSettings{});
-    REQUIRE_THROWS_WITH(fill_random(w, BoxRegion({0, 0, 0}, {0.5, 0.5, 0.5}), {{{0.1, 1.0}}}, 0, 5000.0, 1, 200),
-                        Catch::Contains("too small") && Catch::Contains("5000"));
+    // 250 kg is 54 % of the box as solid: below the densest packing, beyond what a random fill reaches
+    REQUIRE_THROWS_WITH(fill_random(w, BoxRegion({0, 0, 0}, {0.5, 0.5, 0.5}), {{{0.1, 1.0}}}, 0, 250.0, 1, 200),
+                        Catch::Contains("too small") && Catch::Contains("250"));
     REQUIRE_THROWS_WITH(fill_random(w, BoxRegion({0, 0, 0}, {1, 1, 1}), {{{0.1, 0.5}, {0.05, 0.3}}}, 0, 10.0, 1),
                         Catch::Contains("sum to 0.8"));
+    // more solid than the densest packing of spheres (74 %) leaves room for: refused before any try. 2,000 kg at
+    // 3,700 kg/m3 is 0.54 m3, within 0.74 of a 1 m3 box; 2,800 kg is 0.757 m3, beyond it
+    World empty(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    const double density = empty.materials().material(0).density_kg_per_m3;
+    REQUIRE(density == 3700.0);
+    REQUIRE_THROWS_WITH(fill_random(empty, BoxRegion({0, 0, 0}, {1, 1, 1}), {{{0.1, 1.0}}}, 0, 2800.0, 1, 1),
+                        Catch::Contains("more than the box of 1 m3 holds") && Catch::Contains("2739.85 kg"));
+    REQUIRE(empty.particles().size() == 0);
+    REQUIRE_NOTHROW(require_mass_fits(2739.0, density, {0, 0, 0}, {1, 1, 1}, "the test"));
+    // a count beyond what is made at once is refused with the count, not left to the allocator
+    REQUIRE_THROWS_WITH(radii_for_mass({{{1e-6, 1.0}}}, density, 2000.0), Catch::Contains("1.29") && Catch::Contains("particles"));
+    REQUIRE(particles_for_mass({{{0.1, 1.0}}}, density, 2000.0) == Approx(2000.0 / sphere_mass_kg(0.1, density)).epsilon(1e-12));
 }
 
 TEST_CASE("lattice fill places a regular grid", "[dem][insertion][unit]")

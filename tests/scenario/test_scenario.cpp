@@ -155,6 +155,15 @@ TEST_CASE("every class of scenario error names file, line, column, key, value an
         std::regex("    rate_kg_per_s: 1000\n"), "    rate_kg_per_s: 1000\n    start_s: 0.5\n");
     REQUIRE(late_pour.find("fills:") == std::string::npos);
     CHECK_THAT(error_of(late_pour), Catch::Contains("first pour starts at t = 0.5 s") && Catch::Contains("time.step_s"));
+    // a mass no box or memory can hold: refused as it is read, before any particle is made (1e12 kg of 40-50 mm
+    // spheres would be 10^15 of them; before, the fill died in the allocator with "std::bad_alloc")
+    e = error_of(std::regex_replace(small_scenario(), std::regex("mass_kg: 300"), "mass_kg: 1e12"));
+    CHECK_THAT(e, Catch::Contains("fills[0].mass_kg: 1e+12 kg at") && Catch::Contains("more than the box of 0.5 m3 holds") &&
+                      Catch::Contains("make the box larger or the mass smaller"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("radius_m: 0.05"), "radius_m: 1e-6"));
+    CHECK_THAT(e, Catch::Contains("fills[0].mass_kg: got 300; expected a mass of at most 100000000 particles"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("mass_kg: 100\n"), "mass_kg: 1e12\n"));
+    CHECK_THAT(e, Catch::Contains("pours[0].mass_kg: got 1e+12; expected a mass of at most 100000000 particles"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("dipper_scenario: 1"), "dipper_scenario: 2"));
     CHECK_THAT(e, Catch::Contains("case.yaml:1:18: dipper_scenario: got 2; expected 1"));
 
