@@ -26,6 +26,16 @@ std::uint32_t ParticleStore::add(const ParticleSpawn& s, const MaterialTable& ma
     if (!is_finite(s.velocity_m_per_s)) throw InputError(concat("velocity_m_per_s must be finite (", where, ")"));
     if (!is_finite(s.angular_velocity_rad_per_s))
         throw InputError(concat("angular_velocity_rad_per_s must be finite (", where, ")"));
+    // A particle's centre or rim faster than kMaxSpeed_m_per_s is a corrupt value, not a state of a mine: at
+    // 1e300 m/s the kinetic energy overflows to inf and the outputs would carry it on
+    const Vec3& v = s.velocity_m_per_s;
+    const Vec3& w = s.angular_velocity_rad_per_s;
+    if (!(norm(v) <= kMaxSpeed_m_per_s))
+        throw InputError(concat("velocity_m_per_s (", v.x, ", ", v.y, ", ", v.z, "): expected a speed of at most ",
+                                kMaxSpeed_m_per_s, " m/s (", where, ")"));
+    if (!(norm(w) * s.radius_m <= kMaxSpeed_m_per_s))
+        throw InputError(concat("angular_velocity_rad_per_s (", w.x, ", ", w.y, ", ", w.z, ") at radius ", s.radius_m,
+                                " m: expected a rim speed of at most ", kMaxSpeed_m_per_s, " m/s (", where, ")"));
     if (s.material >= materials.size())
         throw InputError(concat("material index ", s.material, " does not exist; the table has ", materials.size(),
                                 " materials (", where, ")"));

@@ -20,6 +20,9 @@ struct ParticleSpawn {
     MaterialIndex material = 0;
 };
 
+/// The fastest a new particle's centre or rim may move, m/s: 100 times a blast's fragments (about 100 m/s).
+constexpr double kMaxSpeed_m_per_s = 1e4;
+
 /// Sphere state. Arrays are indexed by a dense index that the neighbour search may permute (particles
 /// are sorted by cell for memory locality); `id` is the particle's stable number for output and for
 /// code outside the module.
@@ -28,8 +31,8 @@ public:
     std::size_t size() const { return position_m.size(); }
     void reserve(std::size_t n);
 
-    /// Appends a validated particle; mass and inertia come from the material's density. Returns the
-    /// stable id. `where` names the source for error messages.
+    /// Appends a validated particle (finite, at most kMaxSpeed_m_per_s); mass and inertia come from the
+    /// material's density. Returns the stable id. `where` names the source for error messages.
     std::uint32_t add(const ParticleSpawn& spawn, const MaterialTable& materials, const std::string& where);
 
     /// Reorders every array so that new index k holds what old index order[k] held.

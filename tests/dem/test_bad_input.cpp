@@ -21,6 +21,12 @@ TEST_CASE("bad particles are refused by name", "[dem][input][unit]")
     REQUIRE_THROWS_WITH(w.add_particle({{0, std::nan(""), 0}, {}, {}, 0.1, 0}), Contains("position_m"));
     REQUIRE_THROWS_WITH(w.add_particle({{}, {}, {}, 0.1, 99}), Contains("material index 99"));
     REQUIRE_THROWS_WITH(w.add_particle({{}, {}, {}, 0.1, w.materials().index_of("ground")}), Contains("surface material"));
+    // finite but absurd speeds (a corrupt pile file): at 1e300 m/s the kinetic energy was inf in every output
+    REQUIRE_THROWS_WITH(w.add_particle({{}, {1e300, 0, 0}, {}, 0.1, 0}, "sphere 7"),
+                        Contains("velocity_m_per_s (1e+300, 0, 0)") && Contains("at most 10000 m/s") && Contains("sphere 7"));
+    REQUIRE_THROWS_WITH(w.add_particle({{}, {}, {0, 0, 2e5}, 0.1, 0}), Contains("rim speed of at most 10000 m/s"));
+    REQUIRE_NOTHROW(w.add_particle({{}, {1e4, 0, 0}, {0, 0, 1e5}, 0.1, 0}));  // both exactly at the bound
+    CHECK(w.particles().size() == 1);
 }
 
 TEST_CASE("bad materials and coefficients are refused by name", "[dem][input][unit]")
