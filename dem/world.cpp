@@ -186,8 +186,25 @@ void World::sum_wall_reactions()
 
 double World::reference_step_s() const
 {
+    const std::size_t i = step_setting_particle();
+    if (i >= particles_.size()) return std::numeric_limits<double>::infinity();
+    return std::sqrt(particles_.mass_kg[i] / stiffest_contact_N_per_m(i));
+}
+
+double World::stiffest_contact_N_per_m(std::size_t i) const
+{
     // The stiffest contact particle i can have is against a wall (eq. 4 with r2 -> inf): k_i r_i C,
     // with C the largest C_norm of any pair its material has. A sphere pair has m* K <= m_i k_i r_i C.
+    const MaterialIndex a = particles_.material[i];
+    double max_scale = 0.0;
+    for (std::size_t b = 0; b < materials_.size(); ++b)
+        if (materials_.has_pair(a, static_cast<MaterialIndex>(b)))
+            max_scale = std::max(max_scale, materials_.pair_unchecked(a, static_cast<MaterialIndex>(b)).normal_stiffness_scale);
+    return materials_.material(a).bulk_modulus_Pa() * particles_.radius_m[i] * max_scale;
+}
+
+std::size_t World::step_setting_particle() const
+{
     std::vector<double> max_scale(materials_.size(), 0.0);
     for (std::size_t a = 0; a < materials_.size(); ++a)
         for (std::size_t b = 0; b < materials_.size(); ++b)
@@ -196,12 +213,16 @@ double World::reference_step_s() const
                                                                                 static_cast<MaterialIndex>(b))
                                                           .normal_stiffness_scale);
     double best = std::numeric_limits<double>::infinity();
+    std::size_t best_i = particles_.size();
     for (std::size_t i = 0; i < particles_.size(); ++i) {
         const MaterialIndex a = particles_.material[i];
         const double k = materials_.material(a).bulk_modulus_Pa() * particles_.radius_m[i] * max_scale[a];
-        if (k > 0.0) best = std::min(best, std::sqrt(particles_.mass_kg[i] / k));
+        if (k > 0.0 && std::sqrt(particles_.mass_kg[i] / k) < best) {
+            best = std::sqrt(particles_.mass_kg[i] / k);
+            best_i = i;
+        }
     }
-    return best;
+    return best_i;
 }
 
 double World::step_s() const

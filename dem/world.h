@@ -105,6 +105,10 @@ public:
     // ---- time step -----------------------------------------------------------------------------
     /// sqrt(m_i / K_max,i) minimised over particles, K_max,i the stiffest contact particle i can have.
     double reference_step_s() const;
+    /// The particle (dense index) whose sqrt(m_i / K_max,i) is reference_step_s; size() when none has a contact.
+    std::size_t step_setting_particle() const;
+    /// K_max,i of particle i: its normal stiffness against a wall with the largest C_norm of its material's pairs.
+    double stiffest_contact_N_per_m(std::size_t i) const;
     double stable_step_limit_s() const { return kStableStepFactor * reference_step_s(); }
     double step_s() const;  ///< the step in use (the default is resolved when particles exist)
 

@@ -209,6 +209,7 @@ public:
         if (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))
             throw InputError(concat("--stop-after ", options_.stop_after_s, " s: the run is already at t = ", world_->time_s(),
                                     " s; give a later time"));
+        require_reasonable_step_count(end_s - world_->time_s(), dt);
         try {
             while (!reached(end_s)) {
                 const std::uint64_t before = world_->step_count();
@@ -524,6 +525,29 @@ private:
         if (fs::exists(dir / "checkpoint.bin")) fs::rename(dir / "checkpoint.bin", dir / "checkpoint.prev.bin", error);
         fs::rename(dir / "checkpoint.next.bin", dir / "checkpoint.bin", error);
         if (error) throw InputError(concat("cannot move the checkpoint into place in '", dir_, "': ", error.message()));
+    }
+
+    /// A run of more than kMaxSteps steps is a mistake in a stiffness, a radius or the step, not a job: it is
+    /// refused with what sets the step, before the first one (it would run for months, the progress line's ETA
+    /// the only sign).
+    void require_reasonable_step_count(double span_s, double dt) const
+    {
+        constexpr double kMaxSteps = 1e9;
+        const double steps = span_s / dt;
+        if (!(steps > kMaxSteps)) return;
+        std::string cause;
+        if (scenario_.step_s > 0.0) {
+            cause = concat("time.step_s = ", dt, " s");
+        } else {
+            const std::size_t i = world_->step_setting_particle();
+            const dem::ParticleStore& p = world_->particles();
+            const dem::Material& m = world_->materials().material(p.material[i]);
+            cause = concat("the default step ", dt, " s, set by particle ", p.id[i], " (radius ", p.radius_m[i], " m, material '",
+                           m.name, "', ", p.mass_kg[i], " kg, stiffest contact ", world_->stiffest_contact_N_per_m(i),
+                           " N/m: check its radius, the material's Young's modulus and the C_norm of its pairs)");
+        }
+        throw InputError(concat(scenario_.source, ": ", span_s, " s of simulated time is ", steps, " steps at ", cause,
+                                "; a run takes at most ", kMaxSteps, " steps"));
     }
 
     void progress(std::chrono::steady_clock::time_point start, std::uint64_t first_step, bool terminal, bool last)

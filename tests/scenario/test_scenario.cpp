@@ -333,6 +333,24 @@ TEST_CASE("a truncated or corrupt checkpoint is refused and the previous one is 
     fs::remove_all(base);
 }
 
+TEST_CASE("a run of more than 10^9 steps is refused with what sets the step", "[scenario]")
+{
+    // C_norm 1e30 instead of 0.05 (a typo in an exponent) makes the default step about 1e-20 s: 0.3 s would be
+    // 10^19 steps, and the run went on for ever with an ETA of millions of hours as the only sign
+    const fs::path dir = fs::temp_directory_path() / "dipper_test_step_count";
+    fs::remove_all(dir);
+    const std::string stiff = small_scenario() + "materials:\n  pairs:\n    - {materials: [ore, ore], normal_stiffness_scale: 1e30}\n";
+    CHECK_THROWS_WITH(run_scenario(parse_scenario(stiff, "stiff.yaml", "."), dir.string(), quiet()),
+                      Catch::Contains("stiff.yaml: 0.3 s of simulated time is") && Catch::Contains("steps at the default step") &&
+                          Catch::Contains("set by particle") && Catch::Contains("radius 0.04 m, material 'ore'") &&
+                          Catch::Contains("a run takes at most 1000000000 steps"));
+    // a step given in the file is named as such
+    const std::string tiny = std::regex_replace(small_scenario(), std::regex("duration_s: 0.3"), "duration_s: 0.3\n  step_s: 1e-12");
+    CHECK_THROWS_WITH(run_scenario(parse_scenario(tiny, "tiny.yaml", "."), dir.string(), quiet()),
+                      Catch::Contains("3e+11 steps at time.step_s = 1e-12 s"));
+    fs::remove_all(dir);
+}
+
 TEST_CASE("a diverging run stops with a diagnosis and keeps what it wrote", "[scenario]")
 {
     // the paddle driven down at 40 m/s into the bed: overlaps beyond half a radius within a few steps
