@@ -367,6 +367,9 @@ void require_particle_count(const Scenario& s, const MapReader& r, const Particl
         r.fail("mass_kg", concat(source.mass_kg),
                concat("a mass of at most ", dem::kMaxFillParticles, " particles (this is ", count, " of these sizes at ",
                       density, " kg/m3)"));
+    if (count < 0.5)
+        r.fail("mass_kg", concat(source.mass_kg),
+               concat("a mass of at least one particle (this is ", count, " of these sizes at ", density, " kg/m3)"));
 }
 
 /// The keys fills and pours share: material, mass, box and sizes.

@@ -162,6 +162,8 @@ TEST_CASE("every class of scenario error names file, line, column, key, value an
                       Catch::Contains("make the box larger or the mass smaller"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("radius_m: 0.05"), "radius_m: 1e-6"));
     CHECK_THAT(e, Catch::Contains("fills[0].mass_kg: got 300; expected a mass of at most 100000000 particles"));
+    e = error_of(std::regex_replace(small_scenario(), std::regex("mass_kg: 300"), "mass_kg: 0.01"));
+    CHECK_THAT(e, Catch::Contains("fills[0].mass_kg: got 0.01; expected a mass of at least one particle"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("mass_kg: 100\n"), "mass_kg: 1e12\n"));
     CHECK_THAT(e, Catch::Contains("pours[0].mass_kg: got 1e+12; expected a mass of at most 100000000 particles"));
     e = error_of(std::regex_replace(small_scenario(), std::regex("dipper_scenario: 1"), "dipper_scenario: 2"));
