@@ -557,9 +557,16 @@ private:
         const double interval = terminal ? 0.5 : scenario_.output.progress_interval_s;
         if (!last && since < interval) return;
         last_progress_ = now;
+        // The rate of the last minute or so (each line's rate weighed in by the time it covers), not the average
+        // since the start: a pile that settles or a dig that begins can slow a long run several times over, and
+        // the ETA must follow.
         const double elapsed = std::chrono::duration<double>(now - start).count();
-        const double steps = static_cast<double>(world_->step_count() - first_step);
-        const double rate = elapsed > 0.0 ? steps / elapsed : 0.0;
+        const std::uint64_t step = world_->step_count();
+        if (progress_step_ < first_step) progress_step_ = first_step;
+        const double recent = since > 0.0 ? static_cast<double>(step - progress_step_) / since : 0.0;
+        progress_rate_ = progress_rate(progress_rate_, recent, since, elapsed);
+        progress_step_ = step;
+        const double rate = progress_rate_;
         const double t = world_->time_s(), end = scenario_.duration_s;
         const double left_steps = std::max(0.0, (end - t) / world_->step_s());
         const double eta = rate > 0.0 ? left_steps / rate : -1.0;
@@ -740,6 +747,8 @@ private:
     coupling::LoadedState pile_;  ///< what the scenario's pile placed and left out
     double row_wall_s_ = 0.0;
     std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now(), last_progress_;
+    std::uint64_t progress_step_ = 0;  ///< the step of the last progress line
+    double progress_rate_ = 0.0;       ///< steps per second of wall clock over about the last minute
 };
 
 }  // namespace
@@ -796,6 +805,13 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
     Run run(std::move(scenario), out_dir, o);
     run.start_from(*in);
     return run.loop();
+}
+
+double progress_rate(double previous, double recent, double since_s, double elapsed_s)
+{
+    if (!(previous > 0.0)) return recent;
+    const double span = std::max(since_s, std::min(elapsed_s, 60.0));
+    return span > 0.0 ? previous + since_s / span * (recent - previous) : previous;
 }
 
 int exit_code(const RunResult& result)

@@ -31,6 +31,11 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
 /// FNV-1a hash of every particle's position, velocity and spin in id order: equal hashes, equal states.
 std::uint64_t particle_state_hash(const dem::World& world);
 
+/// The progress line's rate, steps per second of wall clock over about the last minute: `previous` (0 before the
+/// first line) moved towards `recent`, the rate since the last line, by `since_s` / max(since_s, min(elapsed_s, 60)),
+/// elapsed_s being the time since the run (or resumed leg) began. The first line gives `recent`.
+double progress_rate(double previous, double recent, double since_s, double elapsed_s);
+
 /// Exit code of the dipper command for a result: 0 completed, 3 diverged, 130 interrupted.
 int exit_code(const RunResult& result);
 

@@ -335,6 +335,22 @@ TEST_CASE("a truncated or corrupt checkpoint is refused and the previous one is 
     fs::remove_all(base);
 }
 
+TEST_CASE("the progress line's rate follows the last minute, not the average since the start", "[scenario]")
+{
+    CHECK(progress_rate(0.0, 40.0, 10.0, 10.0) == 40.0);  // the first line: its own rate
+    // a run that slowed from 40 to 4 steps/s an hour in: each 10 s line moves the rate a sixth of the way, so
+    // after 10 minutes it is within 0.1 % of 4 steps/s (the average since the start would still say about 35)
+    double rate = 40.0;
+    for (int line = 0; line < 60; ++line) rate = progress_rate(rate, 4.0, 10.0, 3600.0 + 10.0 * line);
+    CHECK(rate == Approx(4.0 + 36.0 * std::pow(5.0 / 6.0, 60)).epsilon(1e-12));
+    CHECK(rate < 4.004);
+    // early in a run the span is the time since the start: the average of the lines so far
+    CHECK(progress_rate(40.0, 10.0, 10.0, 20.0) == Approx(25.0).epsilon(1e-12));
+    // a line longer than a minute takes its own rate
+    CHECK(progress_rate(40.0, 10.0, 120.0, 3600.0) == 10.0);
+    CHECK(progress_rate(40.0, 10.0, 0.0, 3600.0) == 40.0);  // a last line right after the one before
+}
+
 TEST_CASE("a run of more than 10^9 steps is refused with what sets the step", "[scenario]")
 {
     // C_norm 1e30 instead of 0.05 (a typo in an exponent) makes the default step about 1e-20 s: 0.3 s would be
