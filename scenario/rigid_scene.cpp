@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace dipper::scenario {
 
@@ -304,25 +305,34 @@ void RigidScene::check_tunnelling() const
         parts[static_cast<std::size_t>(part)] = {r.transposed(), o, part == 0 ? &dipper_.body.plates : &dipper_.door.plates,
                                                  part_bounds_[static_cast<std::size_t>(part)]};
     }
-    for (std::size_t k = 0; k < coupled_->rocks().size(); ++k) {
-        const rigid::BodyId id = coupled_->rocks()[k].body;
-        const Vec3 c = rigid_->position_m(id);
+    // the plate a rock's centre lies inside, if any (part * 2^16 + plate), read on all threads at full size
+    constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+    auto plate_holding = [&](std::size_t k) {
+        const Vec3 c = rigid_->position_m(coupled_->rocks()[k].body);
         for (std::size_t part = 0; part < parts.size(); ++part) {
             const Part& pt = parts[part];
             const Vec3 q = pt.back * (c - pt.origin);
             if (norm_squared(q - pt.bound.centre) > pt.bound.radius * pt.bound.radius) continue;  // far from every plate
             for (std::size_t p = 0; p < pt.plates->size(); ++p)
-                if (inside_plate((*pt.plates)[p], q)) {
-                    const double dt = coupled_->dem_step_s();
-                    throw SimulationError(concat(
-                        "t = ", coupled_->time_s(), " s: rock ", k, " (", coupled_->rocks()[k].shape.equivalent_diameter_m(),
-                        " m, speed ", norm(rigid_->state(id).velocity_m_per_s), " m/s) has its centre at (", c.x, ", ", c.y,
-                        ", ", c.z, ") m inside plate ", p, " of the ", part == 0 ? "dipper" : "door",
-                        ": it went through the steel. Reduce time.step_s (now ", dt, " s; try ", dt / 2.0,
-                        " s) or coupling.substeps (now ", coupled_->settings().substeps, ")"));
-                }
+                if (inside_plate((*pt.plates)[p], q)) return (part << 16) + p;
         }
-    }
+        return kNone;
+    };
+    const auto rock_count = static_cast<std::ptrdiff_t>(coupled_->rocks().size());
+    std::size_t first = kNone;  // the first rock in order, as one thread would find it
+#pragma omp parallel for schedule(static) reduction(min : first) num_threads(coupled_->dem().threads()) if (rock_count > 256)
+    for (std::ptrdiff_t q = 0; q < rock_count; ++q)
+        if (plate_holding(static_cast<std::size_t>(q)) != kNone) first = std::min(first, static_cast<std::size_t>(q));
+    if (first == kNone) return;
+    const std::size_t k = first, where = plate_holding(k), part = where >> 16, p = where & 0xffffu;
+    const rigid::BodyId id = coupled_->rocks()[k].body;
+    const Vec3 c = rigid_->position_m(id);
+    const double dt = coupled_->dem_step_s();
+    throw SimulationError(concat("t = ", coupled_->time_s(), " s: rock ", k, " (", coupled_->rocks()[k].shape.equivalent_diameter_m(),
+                                 " m, speed ", norm(rigid_->state(id).velocity_m_per_s), " m/s) has its centre at (", c.x, ", ",
+                                 c.y, ", ", c.z, ") m inside plate ", p, " of the ", part == 0 ? "dipper" : "door",
+                                 ": it went through the steel. Reduce time.step_s (now ", dt, " s; try ", dt / 2.0,
+                                 " s) or coupling.substeps (now ", coupled_->settings().substeps, ")"));
 }
 
 void RigidScene::step()

@@ -593,6 +593,33 @@ TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a
                                                     Catch::Contains("went through the steel") && Catch::Contains("Reduce time.step_s"));
 }
 
+TEST_CASE("among many rocks on two threads, the first rock in order inside the steel is the one named", "[scenario][shovel]")
+{
+    // 600 rocks (more than the 256 from which the rocks are read on all threads): 597 on the ground far from the
+    // machine, and rocks 150, 451 and 599 in the bottom plate. Each thread finds its own; the first of all is named.
+    const Scenario s = parse_scenario(std::regex_replace(base("shovel: {element_size_m: 0.3}\n"), std::regex("threads: 1"), "threads: 2"),
+                                      "case.yaml", ".");
+    auto dem = build_world(s);
+    REQUIRE(dem->threads() == 2);
+    RigidScene scene(s, *dem);
+    build_particles(s, *dem);
+    scene.step();
+    std::vector<Vec3> corners;
+    for (double x : {-0.15, 0.15})
+        for (double y : {-0.15, 0.15})
+            for (double z : {-0.15, 0.15}) corners.push_back({x, y, z});
+    const rigid::ConvexPolyhedron cube = rigid::ConvexPolyhedron::hull_of(corners, "cube").in_principal_frame();
+    Mat3 r;
+    Vec3 o;
+    scene.rigid().dipper_pose(r, o);
+    for (int k = 0; k < 600; ++k) {
+        const bool inside = k == 150 || k == 451 || k == 599;
+        const Vec3 centre = inside ? o + r * Vec3{2.0 - 0.001 * k, 0.0, -0.05} : Vec3{-40.0 + 0.5 * (k % 40), 30.0 + 0.5 * (k / 40), 0.2};
+        scene.coupled().add_rock(cube, 3000.0, scene.rigid().material_index("rock"), dem->materials().index_of("rock"), centre);
+    }
+    CHECK_THROWS_WITH(scene.check_tunnelling(), Catch::Contains("rock 150 (") && Catch::Contains("inside plate 0 of the dipper"));
+}
+
 TEST_CASE("a sweep table of shovel runs has each pass's mass, fill factor and forces, the repose angle and the dipper's wear",
           "[scenario][shovel]")
 {
