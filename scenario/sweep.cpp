@@ -205,9 +205,16 @@ Sweep load_sweep(const std::string& path)
         }
         s.parameters.push_back(sp);
     }
-    // every variant must be a valid scenario before anything runs
+    // every variant must be a valid scenario before anything runs; their count first, from the parameters' counts
+    // (three ranges of 10,000 values would be 10^12 variants to list)
+    double product = 1.0;
+    std::string counts;
+    for (const SweepParameter& p : s.parameters) {
+        product *= static_cast<double>(p.values.size());
+        counts += concat(counts.empty() ? "" : " x ", p.values.size(), " (", p.key, ")");
+    }
+    if (product > 100000) throw InputError(concat(path, ": ", product, " variants, ", counts, "; at most 100000"));
     const std::size_t n = s.variants().size();
-    if (n > 100000) throw InputError(concat(path, ": ", n, " variants; at most 100000"));
     for (std::size_t v = 0; v < n; ++v) s.variant_scenario(v);
     return s;
 }
