@@ -209,10 +209,11 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
         if (!(hi[a] > lo[a])) throw InputError(concat(where, ": box corner hi must exceed lo on every axis"));
     dem::require_mass_fits(total_mass_kg, materials.density_kg_per_m3, lo, hi, where);
     {
-        const double sphere_m3 = M_PI / 6.0 * 8.0 * distribution.sphere_radius_m * distribution.sphere_radius_m * distribution.sphere_radius_m;
-        double count = distribution.sphere_mass_fraction * total_mass_kg / materials.density_kg_per_m3 / sphere_m3;
+        // a rock counted as the sphere of its size, as the classes are made below
+        double count = distribution.sphere_mass_fraction * total_mass_kg /
+                       dem::sphere_mass_kg(distribution.sphere_radius_m, materials.density_kg_per_m3);
         for (const RockClass& rc : distribution.rocks)
-            count += rc.mass_fraction * total_mass_kg / materials.density_kg_per_m3 / (M_PI / 6.0 * rc.size_m * rc.size_m * rc.size_m);
+            count += rc.mass_fraction * total_mass_kg / dem::sphere_mass_kg(0.5 * rc.size_m, materials.density_kg_per_m3);
         if (!(count <= dem::kMaxFillParticles))
             throw InputError(concat(where, ": ", total_mass_kg, " kg of this mix makes ", count, " spheres and rocks; at most ",
                                     dem::kMaxFillParticles, " are made at once: check the mass and the sizes"));

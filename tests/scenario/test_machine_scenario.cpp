@@ -569,6 +569,18 @@ TEST_CASE("the force on the lip and its teeth is told from the rest of the dippe
     fs::remove_all(dir);
 }
 
+namespace {
+/// A cube of edge `edge_m` about its centre, as a rock's hull.
+rigid::ConvexPolyhedron cube_rock(double edge_m)
+{
+    std::vector<Vec3> corners;
+    for (double x : {-0.5, 0.5})
+        for (double y : {-0.5, 0.5})
+            for (double z : {-0.5, 0.5}) corners.push_back(Vec3{x, y, z} * edge_m);
+    return rigid::ConvexPolyhedron::hull_of(corners, "cube").in_principal_frame();
+}
+}  // namespace
+
 TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a diagnosis", "[scenario][shovel]")
 {
     const Scenario s = parse_scenario(base("shovel: {element_size_m: 0.3}\n"), "case.yaml", ".");
@@ -579,11 +591,7 @@ TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a
     CHECK_NOTHROW(scene.check_tunnelling());  // no rocks: nothing to check
 
     // a 0.3 m cube with its centre 5 cm deep in the bottom plate (0.1 m thick, below the dipper's z = 0)
-    std::vector<Vec3> corners;
-    for (double x : {-0.15, 0.15})
-        for (double y : {-0.15, 0.15})
-            for (double z : {-0.15, 0.15}) corners.push_back({x, y, z});
-    const rigid::ConvexPolyhedron cube = rigid::ConvexPolyhedron::hull_of(corners, "cube").in_principal_frame();
+    const rigid::ConvexPolyhedron cube = cube_rock(0.3);
     Mat3 r;
     Vec3 o;
     scene.rigid().dipper_pose(r, o);
@@ -604,11 +612,7 @@ TEST_CASE("among many rocks on two threads, the first rock in order inside the s
     RigidScene scene(s, *dem);
     build_particles(s, *dem);
     scene.step();
-    std::vector<Vec3> corners;
-    for (double x : {-0.15, 0.15})
-        for (double y : {-0.15, 0.15})
-            for (double z : {-0.15, 0.15}) corners.push_back({x, y, z});
-    const rigid::ConvexPolyhedron cube = rigid::ConvexPolyhedron::hull_of(corners, "cube").in_principal_frame();
+    const rigid::ConvexPolyhedron cube = cube_rock(0.3);
     Mat3 r;
     Vec3 o;
     scene.rigid().dipper_pose(r, o);
