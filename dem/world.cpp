@@ -165,6 +165,7 @@ void World::set_wall_mass_kg(int wall_id, double mass_kg)
     const auto m = static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index);
     meshes_[m].set_mass_kg(mass_kg);
     mesh_moved_[m] = 1;
+    convex_constants_stale_ = true;
 }
 
 void World::sum_wall_reactions()
@@ -856,6 +857,7 @@ void World::split_candidates()
     }
     // a pair's contact is read only while it touches, so the contacts need no clearing
     convex_contacts_.resize(convex_pairs_.size());
+    convex_constants_.assign(convex_pairs_.size(), ContactConstants{});
     convex_touching_.assign(convex_pairs_.size(), 0);
     convex_push_.assign(convex_pairs_.size(), Push{});
     convex_reaction_.resize(convex_pairs_.size());
@@ -1242,7 +1244,8 @@ bool World::edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::
     return true;
 }
 
-std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep)
+std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep,
+                                           Vec3* __restrict body_force, Vec3* __restrict body_torque)
 {
     // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in front of one
     // of the faces within reach touches none of them. A centre in front of some face lies outside, and the hull's
@@ -1254,8 +1257,10 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
     // The pairs stream in order, but each meets its body's frame and its own contact record (read for its
     // history, written when touching) out of the order the hardware prefetches: both are fetched a few pairs
     // ahead, with the faces (on a bed of 20,000 spheres and 1,000 rocks the sphere-body phase took 13 % less
-    // time, docs/BENCHMARKS.md).
+    // time, docs/BENCHMARKS.md). The faces take a fixed six lines, their 4.1 faces' 394 bytes on average there:
+    // a loop over each pair's own count missed its end at every pair.
     constexpr std::size_t kAhead = 8;
+    constexpr std::size_t kFaceLines = 6, kAcrossLines = 2;
     auto prefetch = [](const void* at, std::size_t bytes) {
         for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(static_cast<const char*>(at) + line);
     };
@@ -1266,8 +1271,9 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
             const ConvexPair& next = convex_pairs_[k + kAhead];
             prefetch(&convex_frames_[next.mesh], sizeof(ConvexFrame));
             prefetch(&convex_contacts_[k + kAhead], sizeof(WallContact));
-            prefetch(&convex_faces_[next.face_begin], (next.face_end - next.face_begin) * sizeof(PackedTriangle));
-            prefetch(&convex_face_across_[next.face_begin], (next.face_end - next.face_begin) * sizeof(FaceAcross));
+            prefetch(&convex_constants_[k + kAhead], sizeof(ContactConstants));
+            prefetch(&convex_faces_[next.face_begin], kFaceLines * 64);
+            prefetch(&convex_face_across_[next.face_begin], kAcrossLines * 64);
         }
         const ConvexFrame& frame = convex_frames_[pair.mesh];
         const std::uint32_t i = pair.particle;
@@ -1295,27 +1301,36 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
             // face lies inside it, this is that face, and one query settles the body
             const PackedTriangle& ft = convex_faces_[farthest_f];
             meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
-            if (best_cp.feature == meshes::Feature::Edge && edge_point_is_closest(farthest_f, xb, best_cp, face)) {
-                // settled by the face across the edge (most closest points off a face lie on an edge)
-            } else if (best_cp.feature != meshes::Feature::Face) {
-                for (std::uint32_t f = pair.face_begin; f < pair.face_end; ++f) {
-                    const PackedTriangle& pt = convex_faces_[f];
-                    const double d = dot(xb - pt.a, pt.normal);
-                    if (f == farthest_f || d <= 0.0 || d * d >= best_cp.distance_squared) continue;
-                    const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
-                    if (cp.distance_squared < best_cp.distance_squared) {
-                        face = f;
-                        best_cp = cp;
-                        if (cp.feature == meshes::Feature::Face) break;
+            if (best_cp.feature == meshes::Feature::Face) {
+                // over the face: its plane gives the distance, the normal and the point, with no square root or
+                // division in the way (on the bench bed two in three contacts, and 6 % off the pass)
+                touches = farthest < r;
+                normal_b = ft.normal;
+                point_b = xb - ft.normal * farthest;
+                overlap = r - farthest;
+            } else {
+                // a point on an edge is settled by the face across it (most closest points off a face lie on an
+                // edge); else by the other faces the centre is in front of
+                if (best_cp.feature != meshes::Feature::Edge || !edge_point_is_closest(farthest_f, xb, best_cp, face)) {
+                    for (std::uint32_t f = pair.face_begin; f < pair.face_end; ++f) {
+                        const PackedTriangle& pt = convex_faces_[f];
+                        const double d = dot(xb - pt.a, pt.normal);
+                        if (f == farthest_f || d <= 0.0 || d * d >= best_cp.distance_squared) continue;
+                        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
+                        if (cp.distance_squared < best_cp.distance_squared) {
+                            face = f;
+                            best_cp = cp;
+                            if (cp.feature == meshes::Feature::Face) break;
+                        }
                     }
                 }
-            }
-            if (best_cp.distance_squared < r * r) {
-                touches = true;
-                const double dist = std::sqrt(best_cp.distance_squared);
-                point_b = best_cp.point;
-                normal_b = dist > 1e-12 * r ? (xb - best_cp.point) * (1.0 / dist) : convex_faces_[face].normal;
-                overlap = r - dist;
+                if (best_cp.distance_squared < r * r) {
+                    touches = true;
+                    const double dist = std::sqrt(best_cp.distance_squared);
+                    point_b = best_cp.point;
+                    normal_b = dist > 1e-12 * r ? (xb - best_cp.point) * (1.0 / dist) : convex_faces_[face].normal;
+                    overlap = r - dist;
+                }
             }
         } else if (!separated) {
             touches = true;
@@ -1348,18 +1363,25 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         const double m = particles_.mass_kg[i];
         const WallMotion& motion = frame.motion;
         const PairCoefficients& p = materials_.pair_unchecked(mat, motion.material);
-        const ContactConstants constants =
-            contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
-                              motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r, p);
+        ContactConstants& constants = convex_constants_[k];
+        if (constants.normal_stiffness_N_per_m == 0.0)
+            constants = contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
+                                          motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r, p);
         const Vec3 relative_velocity = v + cross(w, c.point - x) - motion.velocity_at(c.point);
         c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - motion.angular_velocity_rad_per_s, constants,
                                          c.history, dt_s);
         c.relative_displacement_m = relative_velocity * dt_s;
         const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
         convex_push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
-        // the body's reaction, while the contact is in cache (summed per body after all pairs are done)
+        // the body's reaction, while the contact is in cache
         const Vec3 on_wall = -force;
-        convex_reaction_[k] = {on_wall, cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m};
+        const Vec3 on_wall_torque = cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
+        if (body_force) {
+            body_force[frame.wall] += on_wall;
+            body_torque[frame.wall] += on_wall_torque;
+        } else {
+            convex_reaction_[k] = {on_wall, on_wall_torque};
+        }
         if (first_deep == kNoContact && c.overlap_m / r > settings_.max_overlap_ratio) first_deep = k;
     }
     return touching;
@@ -1412,6 +1434,10 @@ void World::compute_wall_contacts(double dt_s)
     thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
+    if (convex_constants_stale_) {
+        std::fill(convex_constants_.begin(), convex_constants_.end(), ContactConstants{});
+        convex_constants_stale_ = false;
+    }
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
         // the records of the meshes moved (or given a mass) since the last wall phase: in a coupled bed every rock
@@ -1449,8 +1475,13 @@ void World::compute_wall_contacts(double dt_s)
         // the spheres near convex bodies, in particle order: each pair's contact in its place
         std::size_t first_deep_convex = kNoContact;
         auto convex_start = std::chrono::steady_clock::now();
-        convex_touching += compute_convex_contacts(convex_pass_start_[static_cast<std::size_t>(t)],
-                                                   convex_pass_start_[static_cast<std::size_t>(t) + 1], dt_s, first_deep_convex);
+        // A body's reaction is summed over the pairs of each thread's block of particles, in order, so that it is the
+        // same sum however the pairs' contacts were shared out; where the thread's share is that block (one
+        // thread), in the pass itself.
+        const auto ut = static_cast<std::size_t>(t);
+        const bool sum_in_pass = convex_pass_start_[ut] == convex_thread_start_[ut] && convex_pass_start_[ut + 1] == convex_thread_start_[ut + 1];
+        convex_touching += compute_convex_contacts(convex_pass_start_[ut], convex_pass_start_[ut + 1], dt_s, first_deep_convex,
+                                                   sum_in_pass ? wall_force : nullptr, sum_in_pass ? wall_torque : nullptr);
         thread_convex_seconds_[static_cast<std::size_t>(t)] = seconds_since(convex_start);
         thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
 
@@ -1501,7 +1532,7 @@ void World::compute_wall_contacts(double dt_s)
         // the convex bodies' reactions: the pairs of the thread's particles, in order (the same sums whichever
         // thread computed the contacts)
         convex_start = std::chrono::steady_clock::now();
-        for (std::size_t q = convex_thread_start_[static_cast<std::size_t>(t)]; q < convex_thread_start_[static_cast<std::size_t>(t) + 1]; ++q) {
+        for (std::size_t q = convex_thread_start_[ut]; q < convex_thread_start_[ut + 1] && !sum_in_pass; ++q) {
             if (!convex_touching_[q]) continue;
             const auto w = static_cast<std::size_t>(mesh_wall_id_[convex_pairs_[q].mesh]);
             wall_force[w] += convex_reaction_[q].force_N;

@@ -204,9 +204,11 @@ private:
     void split_convex_contacts();
     /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
     std::vector<WallContact> merged_wall_contacts() const;
-    /// The contacts of convex pairs [begin, end), with each touching pair's reaction on its body in
-    /// convex_reaction_ and the first pair past the overlap limit in first_deep; returns how many touch.
-    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep);
+    /// The contacts of convex pairs [begin, end), with the first pair past the overlap limit in first_deep; returns
+    /// how many touch. Each touching pair's reaction on its body is added to body_force and body_torque (by wall),
+    /// or stored in convex_reaction_ when they are null.
+    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep,
+                                        Vec3* body_force, Vec3* body_torque);
     /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
     void apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const;
     void evaluate_forces(double dt_s, double half_kick_s);
@@ -291,6 +293,10 @@ private:
     bool edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
                                std::uint32_t& best_face) const;
     std::vector<ConvexPair> convex_pairs_;
+    /// beside convex_pairs_: the constants of the pair's law (eq. 4, 6, 8), found when it first touches after a
+    /// rebuild; a stiffness of zero (never a pair's: C_norm > 0) marks them not found yet
+    std::vector<ContactConstants> convex_constants_;
+    bool convex_constants_stale_ = false;  ///< a body's mass changed: every pair's constants are found again
     std::vector<PackedTriangle> convex_faces_;       ///< body frame, the faces within reach of each pair in turn
     std::vector<std::int32_t> convex_face_triangle_; ///< beside convex_faces_: the mesh's triangle
     /// The face across each edge (ab, bc, ca) of a pair's face among the pair's faces (the first in order that

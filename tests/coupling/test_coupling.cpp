@@ -518,9 +518,12 @@ TEST_CASE("a light rock buried in spheres runs away at n = 5 and the runaway gua
     // A 0.35 m cube of 12.9 kg (density 300 kg/m^3, lighter than one 14.75 kg sphere) lies on a bed of
     // 200 mm spheres and is buried under 850 kg more. At n = 5 the rock answers its stiff, damped sphere
     // contacts a coupling step late; its velocity change flips and grows each coupling step until a sphere
-    // overlaps it past the limit (measured: t = 1.38 s). With the guard, the flips are caught (measured: 8
-    // times) and the rock answers them at every DEM step for a while: the run goes on to 2.5 s. Also checked:
-    // the rock stays in the box and under the spheres (the guard's exchanges move it as any other, no jump).
+    // overlaps it past the limit or the rock is thrown out of the bed (the box's walls hold only the spheres).
+    // Which of the two comes first is a matter of the last bit: measured, a stop at t = 1.38 s, and with other
+    // round-off in the sphere-rock contacts the rock at (0.53, -1.00, 1.47) m at 2.5 s, out of the 0.8 m box.
+    // With the guard, the flips are caught (measured: 8 and 20 times) and the rock answers them at every DEM step
+    // for a while: the run goes on to 2.5 s. Also checked: the rock stays in the box and under the spheres (the
+    // guard's exchanges move it as any other, no jump).
     std::printf("buried light rock, n = 5: runaway guard off, on\n");
     for (bool guard : {false, true}) {
         auto s = make_scene(5, {0.0, 0.0, -9.81}, dem::MaterialTable::aitik_copper_ore(), guard);
@@ -572,8 +575,9 @@ TEST_CASE("a light rock buried in spheres runs away at n = 5 and the runaway gua
         std::printf("  guard %-3s  t = %.3f s  caught %llu, guarded coupling steps %llu, rock at (%.2f, %.2f, %.2f) m%s\n",
                     guard ? "on" : "off", s->world.time_s(), static_cast<unsigned long long>(s->world.runaways_caught()),
                     static_cast<unsigned long long>(s->world.guarded_steps()), x.x, x.y, x.z, stopped.empty() ? "" : ": stopped");
-        if (!guard) {
-            CHECK(stopped.find("overlaps wall 'rock_") != std::string::npos);  // the rock ran away
+        if (!guard) {  // the rock ran away
+            const bool thrown_out = std::abs(x.x) > 0.4 || std::abs(x.y) > 0.4 || x.z > bed_top_m(s->dem);
+            CHECK((stopped.find("overlaps wall 'rock_") != std::string::npos || thrown_out));
             CHECK(s->world.runaways_caught() == 0);
             continue;
         }

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <random>
 
 using namespace dipper;
@@ -349,14 +350,43 @@ TEST_CASE("spheres around a convex mesh touch it exactly where their centre is w
         const auto i = static_cast<std::size_t>(c.particle_index);
         ++per_particle[i];
         // the one contact is at the closest point: its overlap is r minus the distance (to round-off of
-        // coordinates near 1 m) and its point lies on the surface, a radius minus the overlap from the centre
+        // coordinates near 1 m) and its point lies on the surface, a radius minus the overlap from the centre,
+        // along the unit normal (over a face, the face's plane gives all three)
         const Vec3 x = w.particles().position_m[i];
         CHECK(c.overlap_m == Approx(r - box.distance_m(x)).margin(1e-12));
         CHECK(box.distance_m(c.point_world) == Approx(0.0).margin(1e-12));
         CHECK(norm(c.point_world - x) == Approx(r - c.overlap_m).margin(1e-12));
+        CHECK(norm(c.normal_world) == Approx(1.0).margin(1e-12));
+        CHECK(norm(x - c.point_world - c.normal_world * (r - c.overlap_m)) < 1e-12);
     }
     for (std::size_t i = 0; i < placed.size(); ++i)
         CHECK(per_particle[i] == (box.distance_m(w.particles().position_m[i]) < r ? 1 : 0));
+
+    // The same box and spheres turned and moved as one: the same contacts, turned and moved (the search works in
+    // the body's frame and hands back world normals and points). Tolerance: round-off of coordinates near 3 m.
+    const Mat3 turn = rotation_about_axis(normalized(Vec3{1.0, 2.0, 3.0}), 0.7);
+    const Vec3 shift{2.0, -1.0, 0.5};
+    World turned(test::two_material_table(kSticky, 3700.0, 45e9, 0.3), settings);
+    const int id = turned.add_mesh(box, 1, "box");
+    turned.set_mesh_pose(id, turn, shift, shift, {}, {});
+    for (const Vec3& p : placed) turned.add_particle({turn * p + shift, {}, {}, r, 0});
+    turned.step();
+    // the records by the spheres' stable ids (each world orders its spheres by its own grid)
+    auto by_id = [](const World& world) {
+        std::map<std::uint32_t, ContactRecord> out;
+        for (const ContactRecord& c : world.last_contact_records())
+            out[world.particles().id[static_cast<std::size_t>(c.particle_index)]] = c;
+        return out;
+    };
+    const auto plain = by_id(w), moved = by_id(turned);
+    REQUIRE(moved.size() == plain.size());
+    for (const auto& [sphere, a] : plain) {
+        REQUIRE(moved.count(sphere) == 1);
+        const ContactRecord& b = moved.at(sphere);
+        CHECK(b.overlap_m == Approx(a.overlap_m).margin(1e-12));
+        CHECK(norm(b.normal_world - turn * a.normal_world) < 1e-12);
+        CHECK(norm(b.point_world - (turn * a.point_world + shift)) < 1e-11);
+    }
 }
 
 TEST_CASE("contacts on a convex body keep their history over neighbour-list rebuilds and checkpoints", "[dem][walls][unit]")
