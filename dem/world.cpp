@@ -788,31 +788,22 @@ void World::split_candidates()
 {
     // Planes and open meshes stay with their particle; a convex body's triangles become one pair of the sphere
     // and that body, with the faces copied beside it (candidates_ lists a particle's triangles mesh by mesh, so a
-    // body's faces are one run). The pairs are in particle order: the spheres' state is then read in one sweep,
-    // and each thread's pairs, those of the particles whose forces it gathers (thread_block, as the gather's
-    // static schedule), are one block.
+    // body's faces are one run). The pairs are in particle order: the spheres' state is then read in one sweep.
     const std::size_t n = candidate_start_.empty() ? 0 : candidate_start_.size() - 1;
     convex_pairs_.clear();
-    convex_thread_start_.assign(static_cast<std::size_t>(threads_) + 1, 0);
-    for (int t = 0; t < threads_; ++t) {
-        std::size_t begin, end;
-        thread_block(n, t, threads_, begin, end);
-        convex_thread_start_[static_cast<std::size_t>(t)] = convex_pairs_.size();
-        for (std::size_t i = begin; i < end; ++i) {
-            for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1];) {
-                const MeshCandidate mc = candidates_[k];
-                if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) {
-                    ++k;
-                    continue;
-                }
-                std::uint32_t run_end = k + 1;
-                while (run_end < candidate_start_[i + 1] && candidates_[run_end].mesh == mc.mesh) ++run_end;
-                convex_pairs_.push_back({mc.mesh, static_cast<std::uint32_t>(i), k, run_end});
-                k = run_end;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1];) {
+            const MeshCandidate mc = candidates_[k];
+            if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) {
+                ++k;
+                continue;
             }
+            std::uint32_t run_end = k + 1;
+            while (run_end < candidate_start_[i + 1] && candidates_[run_end].mesh == mc.mesh) ++run_end;
+            convex_pairs_.push_back({mc.mesh, static_cast<std::uint32_t>(i), k, run_end});
+            k = run_end;
         }
     }
-    convex_thread_start_[static_cast<std::size_t>(threads_)] = convex_pairs_.size();
 
     // the faces beside the pairs, in pair order, and the face across each edge of each: every pair's on its own
     // (at full size, about 10^5 pairs per rebuild)
@@ -860,7 +851,6 @@ void World::split_candidates()
     convex_constants_.assign(convex_pairs_.size(), ContactConstants{});
     convex_touching_.assign(convex_pairs_.size(), 0);
     convex_push_.assign(convex_pairs_.size(), Push{});
-    convex_reaction_.resize(convex_pairs_.size());
     convex_contact_count_ = 0;
     convex_pair_start_.assign(n + 1, 0);
     for (const ConvexPair& p : convex_pairs_) ++convex_pair_start_[p.particle + 1];
@@ -919,19 +909,27 @@ void World::split_convex_contacts()
     wall_contact_start_.assign(n + 1, 0);
     for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
     std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
+}
 
+void World::share_convex_pairs()
+{
     // The pairs' contacts are shared out by their cost, not by the particles' blocks: those are equal in
     // particles, and a settling column's lower half holds most of the pairs (in the thesis' calibration pile the
-    // first of two threads took six times the second's share). A pair touching at the rebuild (closest point,
+    // first of two threads took six times the second's share). A pair touching at the last step (closest point,
     // law and contact record) weighs as three apart: in that pile, at 1 s, weights of 1 and 4 left the first
-    // thread's pass 1.45 and 0.88 times as long as the second's.
-    constexpr std::size_t kTouchingWeight = 3;
-    std::size_t total = 0;
-    for (std::uint8_t touching : convex_touching_) total += touching ? kTouchingWeight : 1;
-    convex_pass_start_.assign(static_cast<std::size_t>(threads_) + 1, convex_pairs_.size());
+    // thread's pass 1.45 and 0.88 times as long as the second's. The shares are found at every step from the
+    // pairs' state, so a world read from a checkpoint shares them as the original did, and each thread sums its
+    // share's reactions on the bodies in pair order (the totals are then the same for a thread count).
+    const std::size_t pairs = convex_pairs_.size();
+    convex_pass_start_.assign(static_cast<std::size_t>(threads_) + 1, pairs);
     convex_pass_start_[0] = 0;
+    if (threads_ == 1) return;
+    constexpr std::size_t kTouchingWeight = 3;
+    std::size_t touching = 0;
+    for (std::uint8_t t : convex_touching_) touching += t;
+    const std::size_t total = pairs + (kTouchingWeight - 1) * touching;
     std::size_t sum = 0, t = 1;
-    for (std::size_t k = 0; k < convex_pairs_.size() && t < static_cast<std::size_t>(threads_); ++k) {
+    for (std::size_t k = 0; k < pairs && t < static_cast<std::size_t>(threads_); ++k) {
         while (t < static_cast<std::size_t>(threads_) && sum >= total * t / static_cast<std::size_t>(threads_)) convex_pass_start_[t++] = k;
         sum += convex_touching_[k] ? kTouchingWeight : 1;
     }
@@ -1375,13 +1373,8 @@ std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, d
         convex_push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
         // the body's reaction, while the contact is in cache
         const Vec3 on_wall = -force;
-        const Vec3 on_wall_torque = cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
-        if (body_force) {
-            body_force[frame.wall] += on_wall;
-            body_torque[frame.wall] += on_wall_torque;
-        } else {
-            convex_reaction_[k] = {on_wall, on_wall_torque};
-        }
+        body_force[frame.wall] += on_wall;
+        body_torque[frame.wall] += cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
         if (first_deep == kNoContact && c.overlap_m / r > settings_.max_overlap_ratio) first_deep = k;
     }
     return touching;
@@ -1434,6 +1427,7 @@ void World::compute_wall_contacts(double dt_s)
     thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
+    share_convex_pairs();
     if (convex_constants_stale_) {
         std::fill(convex_constants_.begin(), convex_constants_.end(), ContactConstants{});
         convex_constants_stale_ = false;
@@ -1475,13 +1469,9 @@ void World::compute_wall_contacts(double dt_s)
         // the spheres near convex bodies, in particle order: each pair's contact in its place
         std::size_t first_deep_convex = kNoContact;
         auto convex_start = std::chrono::steady_clock::now();
-        // A body's reaction is summed over the pairs of each thread's block of particles, in order, so that it is the
-        // same sum however the pairs' contacts were shared out; where the thread's share is that block (one
-        // thread), in the pass itself.
         const auto ut = static_cast<std::size_t>(t);
-        const bool sum_in_pass = convex_pass_start_[ut] == convex_thread_start_[ut] && convex_pass_start_[ut + 1] == convex_thread_start_[ut + 1];
         convex_touching += compute_convex_contacts(convex_pass_start_[ut], convex_pass_start_[ut + 1], dt_s, first_deep_convex,
-                                                   sum_in_pass ? wall_force : nullptr, sum_in_pass ? wall_torque : nullptr);
+                                                   wall_force, wall_torque);
         thread_convex_seconds_[static_cast<std::size_t>(t)] = seconds_since(convex_start);
         thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
 
@@ -1529,16 +1519,6 @@ void World::compute_wall_contacts(double dt_s)
         }
         thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
 
-        // the convex bodies' reactions: the pairs of the thread's particles, in order (the same sums whichever
-        // thread computed the contacts)
-        convex_start = std::chrono::steady_clock::now();
-        for (std::size_t q = convex_thread_start_[ut]; q < convex_thread_start_[ut + 1] && !sum_in_pass; ++q) {
-            if (!convex_touching_[q]) continue;
-            const auto w = static_cast<std::size_t>(mesh_wall_id_[convex_pairs_[q].mesh]);
-            wall_force[w] += convex_reaction_[q].force_N;
-            wall_torque[w] += convex_reaction_[q].torque_N_m;
-        }
-        thread_convex_seconds_[static_cast<std::size_t>(t)] += seconds_since(convex_start);
     }
     convex_contact_count_ = convex_touching;
     phase_seconds_.convex_forces += *std::max_element(thread_convex_seconds_.begin(), thread_convex_seconds_.end());

@@ -202,11 +202,12 @@ private:
     void split_candidates();
     /// Moves the history of wall_contacts_ on convex bodies into their pairs; the rest stay, indexed by particle.
     void split_convex_contacts();
+    /// convex_pass_start_ from the pairs' state at the start of this step (compute_wall_contacts)
+    void share_convex_pairs();
     /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
     std::vector<WallContact> merged_wall_contacts() const;
     /// The contacts of convex pairs [begin, end), with the first pair past the overlap limit in first_deep; returns
-    /// how many touch. Each touching pair's reaction on its body is added to body_force and body_torque (by wall),
-    /// or stored in convex_reaction_ when they are null.
+    /// how many touch. Each touching pair's reaction on its body is added to body_force and body_torque (by wall).
     std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep,
                                         Vec3* body_force, Vec3* body_torque);
     /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
@@ -309,12 +310,7 @@ private:
     std::vector<std::uint8_t> convex_touching_;      ///< beside convex_pairs_
     struct Push { Vec3 force_N, torque_N_m; };       ///< on the particle, about its centre
     std::vector<Push> convex_push_;                  ///< beside convex_pairs_ (zero when apart)
-    /// beside convex_pairs_, read only while touching: the pair's reaction on its body (about the body's reference point)
-    std::vector<Push> convex_reaction_;
     std::vector<std::uint32_t> convex_pair_start_, convex_pair_index_;  ///< each particle's pairs
-    /// The pairs of each thread's particles: the thread sums their reactions on the bodies in this order, so that a
-    /// body's reaction is the same sum for a thread count however the pairs' contacts were shared out.
-    std::vector<std::size_t> convex_thread_start_;
     std::vector<std::size_t> convex_pass_start_;     ///< the pairs whose contacts each thread computes: shares of equal cost
     std::size_t convex_contact_count_ = 0;
     std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit

@@ -394,11 +394,14 @@ TEST_CASE("contacts on a convex body keep their history over neighbour-list rebu
     // Four spheres roll down the top of a box (a convex body) with gravity tilted 20 deg. Friction keeps them from
     // slipping through the tangential spring, and the rolling spring holds its limit: both are contact history.
     // A world that rebuilds its lists every step, and one restored from a checkpoint half-way, must move bit for
-    // bit as one that rebuilds only when the skin is used up. A contact that lost its history at a rebuild would
-    // restart both springs from zero, and its sphere would slip and roll differently.
+    // bit as one that rebuilds only when the skin is used up, and give the box the same reaction, on one thread and
+    // on two (the threads' shares of the pairs come from the pairs' state). A contact that lost its history at a
+    // rebuild would restart both springs from zero, and its sphere would slip and roll differently.
+    const int threads = GENERATE(1, 2);
     const double r = 0.05, tilt = 20.0 * 3.14159265358979323846 / 180.0;
     auto make = [&]() {
         WorldSettings settings;
+        settings.threads = threads;
         settings.gravity_m_per_s2 = {9.81 * std::sin(tilt), 0.0, -9.81 * std::cos(tilt)};
         World w(test::two_material_table(test::coefficients(0.5, 0.1, 0.3, 0.3, 0.05), 3700.0, 45e9, 0.3), settings);
         w.add_mesh(meshes::make_box_mesh({0.0, 0.0, 0.0}, {4.0, 1.0, 1.0}), 1, "box");
@@ -441,7 +444,12 @@ TEST_CASE("contacts on a convex body keep their history over neighbour-list rebu
     std::filesystem::remove(path);
     for (int s = kSteps / 2; s < kSteps; ++s) restored.step();
 
-    INFO("step " << plain.step_s() << " s, time " << plain.time_s() << " s");
+    INFO("threads " << threads << ", step " << plain.step_s() << " s, time " << plain.time_s() << " s");
+    for (const World* other : {&rebuilt, &restored}) {
+        const Vec3 f = plain.wall_force_N(0), t = plain.wall_torque_N_m(0);
+        CHECK((f.x == other->wall_force_N(0).x && f.y == other->wall_force_N(0).y && f.z == other->wall_force_N(0).z));
+        CHECK((t.x == other->wall_torque_N_m(0).x && t.y == other->wall_torque_N_m(0).y && t.z == other->wall_torque_N_m(0).z));
+    }
     CHECK(rebuilt.rebuild_count() >= static_cast<std::uint64_t>(kSteps));
     CHECK(plain.rebuild_count() < 20);
     const auto a = state(plain), b = state(rebuilt), c = state(restored);
