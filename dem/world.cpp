@@ -1450,8 +1450,8 @@ void World::compute_wall_contacts(double dt_s)
         const int t = omp_get_thread_num();
         std::size_t begin, end;
         wall_thread_block(t, begin, end);
-        // the thread's share of each wall's reaction, summed after the barrier: a convex body's from the pairs of
-        // the thread's particles, the others' from the thread's contacts (no wall has both)
+        // the thread's share of each wall's reaction, summed after the barrier: a convex body's from the thread's
+        // share of the pairs, the others' from the thread's contacts (no wall has both)
         Vec3* __restrict wall_force = thread_wall_force_N_[static_cast<std::size_t>(t)].data();
         Vec3* __restrict wall_torque = thread_wall_torque_N_m_[static_cast<std::size_t>(t)].data();
         std::fill(wall_force, wall_force + walls_.size(), Vec3{});
