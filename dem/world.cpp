@@ -1472,8 +1472,8 @@ void World::compute_wall_contacts(double dt_s)
         const auto ut = static_cast<std::size_t>(t);
         convex_touching += compute_convex_contacts(convex_pass_start_[ut], convex_pass_start_[ut + 1], dt_s, first_deep_convex,
                                                    wall_force, wall_torque);
-        thread_convex_seconds_[static_cast<std::size_t>(t)] = seconds_since(convex_start);
-        thread_first_deep_convex_[static_cast<std::size_t>(t)] = first_deep_convex;
+        thread_convex_seconds_[ut] = seconds_since(convex_start);
+        thread_first_deep_convex_[ut] = first_deep_convex;
 
         // Last step's contacts have been read (their history): each thread's contacts, in particle order,
         // replace them at the thread's offset, and each thread indexes its own particles.
@@ -1518,7 +1518,6 @@ void World::compute_wall_contacts(double dt_s)
                 first_deep = offset + q;
         }
         thread_first_deep_contact_[static_cast<std::size_t>(t)] = first_deep;
-
     }
     convex_contact_count_ = convex_touching;
     phase_seconds_.convex_forces += *std::max_element(thread_convex_seconds_.begin(), thread_convex_seconds_.end());
