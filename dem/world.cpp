@@ -194,14 +194,25 @@ double World::reference_step_s() const
 
 double World::stiffest_contact_N_per_m(std::size_t i) const
 {
-    // The stiffest contact particle i can have is against a wall (eq. 4 with r2 -> inf): k_i r_i C,
+    return stiffest_contact_N_per_m(particles_.radius_m[i], particles_.material[i]);
+}
+
+double World::stiffest_contact_N_per_m(double radius_m, MaterialIndex a) const
+{
+    // The stiffest contact a particle can have is against a wall (eq. 4 with r2 -> inf): k_i r_i C,
     // with C the largest C_norm of any pair its material has. A sphere pair has m* K <= m_i k_i r_i C.
-    const MaterialIndex a = particles_.material[i];
     double max_scale = 0.0;
     for (std::size_t b = 0; b < materials_.size(); ++b)
         if (materials_.has_pair(a, static_cast<MaterialIndex>(b)))
             max_scale = std::max(max_scale, materials_.pair_unchecked(a, static_cast<MaterialIndex>(b)).normal_stiffness_scale);
-    return materials_.material(a).bulk_modulus_Pa() * particles_.radius_m[i] * max_scale;
+    return materials_.material(a).bulk_modulus_Pa() * radius_m * max_scale;
+}
+
+double World::default_step_s(double radius_m, MaterialIndex material) const
+{
+    const double k = stiffest_contact_N_per_m(radius_m, material);
+    if (!(k > 0.0)) return std::numeric_limits<double>::infinity();
+    return kDefaultStepFactor * std::sqrt(sphere_mass_kg(radius_m, materials_.material(material).density_kg_per_m3) / k);
 }
 
 std::size_t World::step_setting_particle() const
@@ -1820,11 +1831,16 @@ void World::read_state(StateReader& in)
         in.fail("neighbour arrays of different lengths");
     for (std::size_t k = 0; k < pair_i_.size(); ++k)
         if (pair_i_[k] >= n || pair_j_[k] >= n) in.fail("a neighbour pair names a particle that does not exist");
-    if (prepared_ && (reference_position_m_.size() != n || stiffness_radius_N_per_m_.size() != n))
+    // particles added since the last neighbour rebuild (a pour) are not in the reference and index arrays
+    // yet; the rebuild that rebuild_needed_ asks for takes them in
+    const auto sized = [&](std::size_t size, std::size_t expected) {
+        return rebuild_needed_ ? size <= expected : size == expected;
+    };
+    if (prepared_ && (!sized(reference_position_m_.size(), n) || reference_position_m_.size() != stiffness_radius_N_per_m_.size()))
         in.fail("reference arrays do not match the particle count");
     for (const WallContact& c : wall_contacts_)
         if (c.particle >= n || c.wall < 0 || static_cast<std::size_t>(c.wall) >= walls_.size()) in.fail("a wall contact out of range");
-    if (prepared_ && (wall_contact_start_.size() != n + 1 || candidate_start_.size() != n + 1))
+    if (prepared_ && (!sized(wall_contact_start_.size(), n + 1) || !sized(candidate_start_.size(), n + 1)))
         in.fail("contact index arrays do not match the particle count");
     if (!wall_contact_start_.empty() && wall_contact_start_.back() != wall_contacts_.size()) in.fail("wall contact index mismatch");
     if (!candidate_start_.empty() && candidate_start_.back() != candidates_.size()) in.fail("wall candidate index mismatch");

@@ -109,6 +109,10 @@ public:
     std::size_t step_setting_particle() const;
     /// K_max,i of particle i: its normal stiffness against a wall with the largest C_norm of its material's pairs.
     double stiffest_contact_N_per_m(std::size_t i) const;
+    /// The same for a particle of this radius and material, placed or not.
+    double stiffest_contact_N_per_m(double radius_m, MaterialIndex material) const;
+    /// The default step a particle of this radius and material would bring (infinite if it has no pair).
+    double default_step_s(double radius_m, MaterialIndex material) const;
     double stable_step_limit_s() const { return kStableStepFactor * reference_step_s(); }
     double step_s() const;  ///< the step in use (the default is resolved when particles exist)
 

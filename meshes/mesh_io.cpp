@@ -1,6 +1,7 @@
 #include "meshes/mesh_io.h"
 
 #include "core/errors.h"
+#include "meshes/mesh_file_check.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -20,6 +21,8 @@ TriangleMesh load_triangle_mesh(const std::string& path, double scale)
     require_positive(scale, "mesh scale", path);
     if (!std::filesystem::is_regular_file(path))
         throw InputError(concat("mesh file '", path, "' does not exist or is not a regular file"));
+
+    check_mesh_file(path);  // assimp trusts the counts a file claims
 
     Assimp::Importer importer;
     // Identical vertices are merged so that shared edges are found; no other processing that would

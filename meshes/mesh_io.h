@@ -1,4 +1,4 @@
-// Reading triangle meshes from files (STL, OBJ, PLY and the other formats assimp reads).
+// Reading triangle meshes from STL, OBJ and PLY files, checked (meshes/mesh_file_check.h) before assimp reads them.
 #pragma once
 
 #include "meshes/triangle_mesh.h"

@@ -125,6 +125,7 @@ public:
                 std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
                              scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);
         }
+        require_run_fits(scenario_, *world_);  // before the fills claim the memory
         build_particles(scenario_, *world_);
         if (rigid_) {
             rigid_->fill_mixed(scenario_);
@@ -132,6 +133,7 @@ public:
         }
         pourers_ = make_pourers(scenario_, *world_);
         for (dem::Pourer& p : pourers_) p.update(*world_);
+        require_spheres_at_start(scenario_, *world_);
         world_->prepare();
         open_outputs(false, 0);
         write_row();
@@ -206,6 +208,16 @@ public:
         const auto reached = [&](double t) { return world_->time_s() >= t - 1e-6 * dt; };
         // a shovel run may end after a number of passes: 1 s after the last one's door opened
         const std::size_t passes = scenario_.shovel ? static_cast<std::size_t>(scenario_.shovel->passes) : 0;
+        const auto end_after_passes = [&] {
+            if (passes > 0 && rigid_->passes().size() >= passes)
+                end_s = std::min(end_s, rigid_->passes()[passes - 1].dump_s + 1.0);
+        };
+        end_after_passes();  // a resumed run may have done its passes already
+        if (reached(end_s)) {
+            // a run resumed from its last checkpoint: that checkpoint followed the last row of probes.csv
+            last_row_step_ = world_->step_count();
+            result.message = concat("the run had already ended at t = ", world_->time_s(), " s; its end outputs are written again");
+        }
         if (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))
             throw InputError(concat("--stop-after ", options_.stop_after_s, " s: the run is already at t = ", world_->time_s(),
                                     " s; give a later time"));
@@ -215,24 +227,30 @@ public:
                 const std::uint64_t before = world_->step_count();
                 if (rigid_) {
                     rigid_->step();
-                    if (passes > 0 && rigid_->passes().size() >= passes)
-                        end_s = std::min(end_s, rigid_->passes()[passes - 1].dump_s + 1.0);
+                    end_after_passes();
                 } else {
                     world_->step();
                 }
                 if (world_->step_count() / kPourEvery != before / kPourEvery)
                     for (dem::Pourer& p : pourers_) p.update(*world_);
+                // each schedule moves past now; an interval too short to move it is refused before the run
+                const auto advance = [&](double& next, double interval) {
+                    while (reached(next)) {
+                        if (!(next + interval > next))
+                            throw InputError(concat("an output interval of ", interval, " s cannot advance past t = ", next, " s"));
+                        next += interval;
+                    }
+                };
                 if (reached(next_csv_s_)) {
                     write_row();
-                    while (reached(next_csv_s_)) next_csv_s_ += scenario_.output.csv_interval_s;
+                    advance(next_csv_s_, scenario_.output.csv_interval_s);
                 }
                 if (reached(next_vtk_s_) || reached(end_s)) {
                     write_snapshot();
-                    while (reached(next_vtk_s_))
-                        next_vtk_s_ += scenario_.output.vtk_interval_s > 0.0 ? scenario_.output.vtk_interval_s : end_s;
+                    advance(next_vtk_s_, scenario_.output.vtk_interval_s > 0.0 ? scenario_.output.vtk_interval_s : end_s);
                 }
                 if (reached(next_checkpoint_s_)) {
-                    while (reached(next_checkpoint_s_)) next_checkpoint_s_ += scenario_.output.checkpoint_interval_s;
+                    advance(next_checkpoint_s_, scenario_.output.checkpoint_interval_s);
                     checkpoint();
                 }
                 if (options_.progress) progress(start, first_step, terminal, false);

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <unistd.h>
 
 namespace dipper::scenario {
 
@@ -382,6 +383,13 @@ ParticleSource read_source(const Scenario& s, const MapReader& r, bool fractions
     require_positive(source.mass_kg, "mass_kg", r.where("mass_kg"));
     read_box(r.map("box"), source.min_m, source.max_m, "min_m", "max_m");
     source.sizes = read_sizes(r, fractions_sum_to_one);
+    // a box no wider than a sphere's diameter has no place for its centre (a pour placed nothing, and a
+    // run with no sphere at t = 0 had no time step)
+    const double diameter = 2.0 * source.sizes.max_radius_m();
+    for (int a = 0; a < 3; ++a)
+        if (!(source.max_m[a] - source.min_m[a] > diameter))
+            r.fail("box", concat("a box ", source.max_m[a] - source.min_m[a], " m wide in ", "xyz"[a]),
+                   concat("a box wider than the largest sphere's diameter, ", diameter, " m, in x, y and z"));
     return source;
 }
 
@@ -661,10 +669,13 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
 
     const MapReader out = top.map("output");
     s.output.vtk_interval_s = out.number("vtk_interval_s");
+    s.output.vtk_where = out.where("vtk_interval_s");
     require_non_negative(s.output.vtk_interval_s, "vtk_interval_s", out.where("vtk_interval_s"));
     s.output.csv_interval_s = out.number("csv_interval_s");
+    s.output.csv_where = out.where("csv_interval_s");
     require_positive(s.output.csv_interval_s, "csv_interval_s", out.where("csv_interval_s"));
     s.output.checkpoint_interval_s = out.number("checkpoint_interval_s");
+    s.output.checkpoint_where = out.where("checkpoint_interval_s");
     require_non_negative(s.output.checkpoint_interval_s, "checkpoint_interval_s", out.where("checkpoint_interval_s"));
     s.output.progress_interval_s = out.number("progress_interval_s");
     require_positive(s.output.progress_interval_s, "progress_interval_s", out.where("progress_interval_s"));
@@ -798,6 +809,80 @@ void build_particles(const Scenario& s, dem::World& world)
             throw InputError(concat(f.where, ": ", e.what()));
         }
     }
+}
+
+double planned_step_s(const Scenario& s, const dem::World& world)
+{
+    if (s.step_s > 0.0) return s.step_s;
+    double step = world.particles().size() > 0 ? world.step_s() : std::numeric_limits<double>::infinity();
+    const auto sources = [&](const auto& list) {
+        for (const ParticleSource& p : list) {
+            const dem::MaterialIndex m = world.materials().index_of(p.material);
+            for (const auto& c : p.sizes.classes)
+                if (c.mass_fraction > 0.0) step = std::min(step, world.default_step_s(c.radius_m, m));
+        }
+    };
+    sources(s.fills);
+    sources(s.pours);
+    return step;
+}
+
+double run_memory_bytes(double spheres)
+{
+    constexpr double kBytesPerSphere = 1000.0, kBaseBytes = 64e6;
+    return kBaseBytes + kBytesPerSphere * spheres;
+}
+
+void require_run_fits(const Scenario& s, const dem::World& world)
+{
+    const double step = planned_step_s(s, world);
+    if (std::isfinite(step) && step > 0.0) {
+        const struct {
+            const char* key;
+            double value;
+            const std::string& where;
+        } intervals[] = {{"output.csv_interval_s", s.output.csv_interval_s, s.output.csv_where},
+                         {"output.vtk_interval_s", s.output.vtk_interval_s, s.output.vtk_where},
+                         {"output.checkpoint_interval_s", s.output.checkpoint_interval_s, s.output.checkpoint_where}};
+        for (const auto& i : intervals)
+            if (i.value > 0.0 && i.value < step)
+                throw InputError(concat(i.where.empty() ? concat(s.source, ": ", i.key) : i.where, ": got ", i.value,
+                                        "; expected at least the time step, ", step, " s"));
+    }
+    double spheres = 0.0, most = 0.0;
+    std::string most_where = s.source;
+    const auto count = [&](const auto& list) {
+        for (const ParticleSource& p : list) {
+            const double n = dem::particles_for_mass(p.sizes, s.materials.material(s.materials.index_of(p.material)).density_kg_per_m3,
+                                                     p.mass_kg);
+            spheres += n;
+            if (n > most) most = n, most_where = p.where;
+        }
+    };
+    count(s.fills);
+    count(s.pours);
+    spheres = std::max(spheres, static_cast<double>(world.particles().size()));
+    const double need = run_memory_bytes(spheres);
+    const double have = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+    if (have > 0.0 && need > have)
+        throw InputError(concat(most_where, ": the run's ", std::round(spheres), " spheres (", std::round(most),
+                                " of them here) need about ", std::round(need / 1e8) / 10.0, " GB of memory (",
+                                run_memory_bytes(1.0) - run_memory_bytes(0.0), " bytes each) and this machine has ",
+                                std::round(have / 1e8) / 10.0, " GB; make the fills and pours smaller or the spheres larger"));
+}
+
+void require_spheres_at_start(const Scenario& s, const dem::World& world)
+{
+    if (s.step_s > 0.0 || world.particles().size() > 0 || !s.pile.empty()) return;
+    std::string where = s.source;
+    for (const PourSpec& p : s.pours)
+        if (p.start_s == 0.0) {
+            where = p.where;
+            break;
+        }
+    throw InputError(concat(where, ": no sphere found room in the pour's box at t = 0, and the default time step comes from "
+                                   "the spheres present at t = 0; make the box wider than the largest sphere's diameter by "
+                                   "more (each try draws a centre anywhere in the box) or set time.step_s"));
 }
 
 std::vector<dem::Pourer> make_pourers(const Scenario& s, const dem::World& world)
