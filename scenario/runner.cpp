@@ -69,7 +69,11 @@ std::string json_escape(const std::string& s)
     for (char c : s) {
         if (c == '"' || c == '\\') out += '\\', out += c;
         else if (c == '\n') out += "\\n";
-        else if (static_cast<unsigned char>(c) < 32) out += ' ';
+        else if (static_cast<unsigned char>(c) < 32) {
+            char u[8];
+            std::snprintf(u, sizeof u, "\\u%04x", static_cast<unsigned>(c));
+            out += u;
+        }
         else out += c;
     }
     return out;
@@ -798,6 +802,9 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
 {
     const fs::path dir(out_dir);
     const std::string path = checkpoint_file.empty() ? (dir / "checkpoint.bin").string() : checkpoint_file;
+    if (!checkpoint_file.empty() && fs::is_directory(checkpoint_file))
+        throw InputError(concat("--from ", checkpoint_file, " is a folder; give a checkpoint file, such as ",
+                                (fs::path(checkpoint_file) / "checkpoint.prev.bin").string()));
     if (!fs::exists(path)) {
         std::string hint;
         if (fs::exists(dir / "checkpoint.next.bin") || fs::exists(dir / "checkpoint.prev.bin"))

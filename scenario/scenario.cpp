@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -140,6 +141,11 @@ public:
         const YAML::Node n = has(key) ? *find(key) : YAML::Load(default_of(key));
         Vec3 v;
         if (!point_of(n, v)) fail(key, shown(n), concat("a list of 3 finite numbers [x, y, z]", unit_hint(key)));
+        // positions, speeds, angles and accelerations of a mine site: a larger number is a typing slip whose
+        // effects surface far from the key (a translate_m of 1e300 was refused as a "degenerate triangle")
+        constexpr double kLargest = 1e6;
+        if (!(std::abs(v.x) <= kLargest && std::abs(v.y) <= kLargest && std::abs(v.z) <= kLargest))
+            fail(key, shown(n), concat("a list of 3 numbers each within +-", kLargest, unit_hint(key)));
         return v;
     }
 
@@ -462,11 +468,90 @@ ShovelSpec read_shovel(const Scenario& s, const MapReader& m)
 
 }  // namespace
 
+/// The text must be UTF-8 (YAML's encoding; names go into JSON and folder names): the first byte that
+/// breaks it is refused with its line and column.
+void require_utf8(const std::string& text, const std::string& source)
+{
+    std::size_t line = 1, column = 1;
+    for (std::size_t k = 0; k < text.size();) {
+        const auto b = static_cast<unsigned char>(text[k]);
+        std::size_t n = b < 0x80 ? 1 : (b >> 5) == 0x6 ? 2 : (b >> 4) == 0xE ? 3 : (b >> 3) == 0x1E ? 4 : 0;
+        bool ok = n > 0 && k + n <= text.size() && !(n == 2 && b < 0xC2);
+        for (std::size_t c = 1; ok && c < n; ++c) ok = (static_cast<unsigned char>(text[k + c]) & 0xC0) == 0x80;
+        if (ok && n == 3) {
+            const auto b1 = static_cast<unsigned char>(text[k + 1]);
+            ok = !(b == 0xE0 && b1 < 0xA0) && !(b == 0xED && b1 >= 0xA0);  // overlong, surrogates
+        }
+        if (ok && n == 4) {
+            const auto b1 = static_cast<unsigned char>(text[k + 1]);
+            ok = !(b == 0xF0 && b1 < 0x90) && !(b == 0xF4 && b1 >= 0x90) && b <= 0xF4;
+        }
+        if (!ok) {
+            char hex[8];
+            std::snprintf(hex, sizeof hex, "0x%02X", b);
+            throw InputError(concat(source, ":", line, ":", column, ": the byte ", hex,
+                                    " is not UTF-8; a scenario file is UTF-8 text (save it as UTF-8)"));
+        }
+        if (b == '\n') ++line, column = 1;
+        else ++column;
+        k += n;
+    }
+}
+
+/// A quoted scalar the file never closes: yaml-cpp reads it to the end of the file as one string, so that
+/// every key after it went missing ("time: got nothing"). A quote opens a scalar only where one starts.
+void require_quotes_closed(const std::string& text, const std::string& source)
+{
+    std::size_t line = 1, column = 0, open_line = 0, open_column = 0;
+    char quote = 0;
+    bool scalar_may_start = true, comment = false;
+    for (std::size_t k = 0; k < text.size(); ++k) {
+        const char c = text[k];
+        ++column;
+        if (c == '\n') {
+            ++line;
+            column = 0;
+            comment = false;
+            if (!quote) scalar_may_start = true;
+            continue;
+        }
+        if (comment) continue;
+        if (quote) {
+            if (quote == '"' && c == '\\') ++k, ++column;  // an escape: the next character is part of the string
+            else if (c == quote && quote == '\'' && k + 1 < text.size() && text[k + 1] == '\'') ++k, ++column;  // '' inside '...'
+            else if (c == quote) quote = 0, scalar_may_start = false;
+            continue;
+        }
+        if (c == ' ' || c == '\t') continue;
+        if (c == '#' && (k == 0 || text[k - 1] == ' ' || text[k - 1] == '\t' || scalar_may_start)) {
+            comment = true;
+            continue;
+        }
+        if ((c == '"' || c == '\'') && scalar_may_start) {
+            quote = c;
+            open_line = line;
+            open_column = column;
+            continue;
+        }
+        // a new scalar may start after a mapping's ':' or a sequence's '-' followed by a space, and inside [ { ,
+        const char next = k + 1 < text.size() ? text[k + 1] : '\n';
+        scalar_may_start = c == '[' || c == '{' || c == ',' || ((c == ':' || c == '-' || c == '?') && (next == ' ' || next == '\n' || next == '\t'));
+    }
+    if (quote)
+        throw InputError(concat(source, ":", open_line, ":", open_column, ": the quoted value that starts here (", quote,
+                                ") is never closed; close it with ", quote, " on its line"));
+}
+
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::string& base_dir)
 {
+    require_utf8(text, source);
+    require_quotes_closed(text, source);
     YAML::Node root;
     try {
-        root = YAML::Load(text);
+        const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+        if (documents.size() > 1)
+            throw InputError(concat(source, ":", documents[1].Mark().line + 1, ": a second YAML document ('---'); a scenario file holds one"));
+        if (!documents.empty()) root = documents[0];
     } catch (const YAML::Exception& e) {
         throw InputError(concat(source, ":", e.mark.line + 1, ":", e.mark.column + 1, ": not valid YAML: ", e.msg));
     }
@@ -523,6 +608,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         mesh.material = material_known(s, m, "material", true);
         mesh.scale = m.number("scale");
         require_positive(mesh.scale, "scale", m.where("scale"));
+        if (mesh.scale > 1e6) m.fail("scale", concat(mesh.scale), "a scale factor of at most 1e6");
         mesh.rotate_deg = m.vector3("rotate_deg");
         mesh.translate_m = m.vector3("translate_m");
         if (m.has("motion")) {
@@ -651,6 +737,8 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     for (const MapReader& r : probes.maps("regions")) {
         RegionProbe region;
         region.name = r.text("name");
+        for (const RegionProbe& other : s.regions)
+            if (other.name == region.name) r.fail("name", concat("\"", region.name, "\""), "a name no other region has (it names a column of probes.csv)");
         read_box(r, region.min_m, region.max_m, "min_m", "max_m");
         s.regions.push_back(region);
     }
@@ -712,6 +800,9 @@ std::unique_ptr<dem::World> build_world(const Scenario& s)
     settings.gravity_m_per_s2 = s.gravity_m_per_s2;
     settings.step_s = s.step_s;
     settings.threads = s.threads;
+    // a saved pile holds the overlaps of a bed at rest under its own weight (1-2 % of a radius in a deep
+    // one): it loads as it was written, up to the overlap at which any run stops as diverged
+    if (!s.pile.empty()) settings.initial_overlap_tolerance = settings.max_overlap_ratio;
     auto world = std::make_unique<dem::World>(s.materials, settings);
     for (const PlaneSpec& p : s.planes) world->add_plane(p.point_m, p.normal, s.materials.index_of(p.material), p.name);
     for (const MeshSpec& m : s.meshes) {

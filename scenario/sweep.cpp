@@ -178,6 +178,9 @@ Sweep load_sweep(const std::string& path)
         if (!p["key"] || !p["key"].IsScalar()) throw InputError(concat(where, ".key: expected a scenario key path"));
         sp.key = p["key"].Scalar();
         split_key(sp.key, concat(at(path, p["key"]), "parameters[", k, "].key: "));
+        for (const SweepParameter& other : s.parameters)
+            if (other.key == sp.key)
+                throw InputError(concat(at(path, p["key"]), "parameters[", k, "].key: '", sp.key, "' is swept already; each key once"));
         if (p["values"]) {
             if (p["from"] || p["to"] || p["step"]) throw InputError(concat(where, ": give either values or from/to/step, not both"));
             if (!p["values"].IsSequence() || p["values"].size() == 0) throw InputError(concat(at(path, p["values"]), "parameters[", k, "].values: expected a non-empty list"));
@@ -234,8 +237,26 @@ int run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const Run
     const std::size_t n = sweep.variants().size();
     for (std::size_t v = 0; v < n; ++v) {
         if (static_cast<int>(v % static_cast<std::size_t>(ranks)) != rank) continue;
-        const RunResult r = run_scenario(sweep.variant_scenario(v), variant_dir(out_dir, v), options);
-        if (r.status != RunStatus::completed) ++failed;
+        try {
+            const RunResult r = run_scenario(sweep.variant_scenario(v), variant_dir(out_dir, v), options);
+            if (r.status != RunStatus::completed) ++failed;
+        } catch (const InputError& e) {
+            // a variant refused as it starts (a pour that places nothing, too little memory) stops only itself:
+            // its summary says why, and the others run on
+            ++failed;
+            std::fprintf(stderr, "dipper: sweep variant %zu refused: %s\n", v, e.what());
+            std::error_code error;
+            fs::create_directories(variant_dir(out_dir, v), error);
+            const std::string path = variant_dir(out_dir, v) + "/summary.json";
+            std::ofstream out = open_for_writing(path);
+            std::string message;
+            for (char c : std::string(e.what())) {
+                if (c == '"' || c == '\\') message += '\\';
+                message += static_cast<unsigned char>(c) < 32 ? ' ' : c;
+            }
+            out << "{\n  \"status\": \"refused\",\n  \"message\": \"" << message << "\"\n}\n";
+            finish_writing(out, path);
+        }
     }
     return failed;
 }
