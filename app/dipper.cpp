@@ -9,7 +9,6 @@
 #include "core/errors.h"
 #include "scenario/calibrate.h"
 #include "scenario/keys.h"
-#include "scenario/rigid_scene.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
 #include "scenario/sweep.h"
@@ -267,18 +266,7 @@ int main(int argc, char** argv)
                     continue;
                 }
                 const Scenario s = load_scenario(file);
-                const auto world = build_world(s);  // mesh files are read and checked too
-                check_pairs(s);
-                // what the run places at t = 0 before its first step, where the step depends on it: the pours
-                // due at 0 when no fill or pile brings spheres (the same seeds as the run)
-                if (s.step_s == 0.0 && s.pile.empty() && s.fills.empty()) {
-                    std::vector<dem::Pourer> pourers = make_pourers(s, *world);
-                    for (dem::Pourer& p : pourers) p.update(*world);
-                    require_spheres_at_start(s, *world);
-                }
-                require_run_fits(s, *world);
-                // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
-                if (s.uses_coupling()) RigidScene scene(s, *world);
+                check_scenario(s);
                 double fill = 0.0, pour = 0.0;
                 for (const auto& f : s.fills) fill += f.mass_kg;
                 for (const auto& p : s.pours) pour += p.mass_kg;

@@ -299,31 +299,50 @@ MeshFileSummary check_ply(const std::string& path, const std::string& bytes)
                 refuse(path, s.format, where, concat("face ", f, " names vertex ", i, "; the file has ", vertex->count));
     };
     if (format == "ascii") {
-        Words words(bytes, pos, line + 1);
-        std::string w;
+        // one item a line, as readers take them: a line with more or fewer words than its item needs is
+        // refused (a vertex line of four words made the next line a face of none, and assimp aborted)
+        std::size_t at = pos, row = line;
         for (const PlyElement& e : elements)
-            for (std::uint64_t k = 0; k < e.count; ++k)
+            for (std::uint64_t k = 0; k < e.count; ++k) {
+                std::string text;
+                do {
+                    if (at >= bytes.size())
+                        refuse(path, s.format, at_line(row + 1), concat("the file ends in ", e.name, " ", k, " of ", e.count, ": it is cut short"));
+                    std::size_t eol = bytes.find('\n', at);
+                    if (eol == std::string::npos) eol = bytes.size();
+                    text = bytes.substr(at, eol - at);
+                    at = eol + 1;
+                    ++row;
+                } while (text.find_first_not_of(" \t\r") == std::string::npos);
+                std::vector<std::string> w;
+                Words words(text, 0, row);
+                for (std::string x; words.next(x);) w.push_back(x);
+                std::size_t next = 0;
                 for (std::size_t q = 0; q < e.properties.size(); ++q) {
                     const PlyProperty& p = e.properties[q];
-                    const auto word = [&](const char* what) {
+                    const auto number = [&](const char* what) {
                         double v;
-                        if (!words.next(w))
-                            refuse(path, s.format, at_line(words.line()), concat("the file ends in ", e.name, " ", k, " of ", e.count, ": it is cut short"));
-                        if (!finite_number(w, v))
-                            refuse(path, s.format, at_line(words.line()), concat("expected ", what, " in ", e.name, " ", k, "; got '", w, "'"));
+                        if (next >= w.size())
+                            refuse(path, s.format, at_line(row), concat(e.name, " ", k, " has ", w.size(), " numbers on its line; its properties need more"));
+                        if (!finite_number(w[next], v))
+                            refuse(path, s.format, at_line(row), concat("expected ", what, " in ", e.name, " ", k, "; got '", w[next], "'"));
+                        ++next;
                         return v;
                     };
                     if (p.count_size == 0) {
-                        word("a finite number");
+                        number("a finite number");
                         continue;
                     }
-                    const double n = word("a list's count");
+                    const double n = number("a list's count");
                     if (!(n >= 0.0 && n <= 1000.0 && n == std::floor(n)))
-                        refuse(path, s.format, at_line(words.line()), concat("a list of ", n, " items in ", e.name, " ", k));
+                        refuse(path, s.format, at_line(row), concat("a list of ", n, " items in ", e.name, " ", k));
                     std::vector<double> items(static_cast<std::size_t>(n));
-                    for (double& i : items) i = word("an index");
-                    if (&e == face && static_cast<int>(q) == face_list) check_face(k, n, items, at_line(words.line()));
+                    for (double& x : items) x = number("an index");
+                    if (&e == face && static_cast<int>(q) == face_list) check_face(k, n, items, at_line(row));
                 }
+                if (next != w.size())
+                    refuse(path, s.format, at_line(row), concat(e.name, " ", k, " has ", w.size(), " numbers on its line; its properties take ", next));
+            }
         return s;
     }
     const bool little = format == "binary_little_endian";

@@ -798,6 +798,22 @@ RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, con
     return run.loop();
 }
 
+void check_scenario(const Scenario& s)
+{
+    const auto world = build_world(s);  // mesh files are read and checked too
+    check_pairs(s);
+    // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
+    if (s.uses_coupling()) RigidScene scene(s, *world);
+    // what the run places at t = 0 before its first step, where the step depends on it: the pours due at 0
+    // when no fill or pile brings spheres (the same seeds as the run)
+    if (s.step_s == 0.0 && s.pile.empty() && s.fills.empty()) {
+        std::vector<dem::Pourer> pourers = make_pourers(s, *world);
+        for (dem::Pourer& p : pourers) p.update(*world);
+        require_spheres_at_start(s, *world);
+    }
+    require_run_fits(s, *world);
+}
+
 RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)
 {
     const fs::path dir(out_dir);
