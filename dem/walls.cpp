@@ -11,19 +11,21 @@ namespace dipper::dem {
 
 Vec3 PrescribedMotion::pivot_position_m(double t_s) const
 {
-    return pivot_m + velocity_m_per_s * t_s + oscillation_amplitude_m * std::sin(2.0 * M_PI * oscillation_frequency_Hz * t_s);
+    const double tau = moving_s(t_s);
+    return pivot_m + velocity_m_per_s * tau + oscillation_amplitude_m * std::sin(2.0 * M_PI * oscillation_frequency_Hz * tau);
 }
 
 Vec3 PrescribedMotion::pivot_velocity_m_per_s(double t_s) const
 {
+    if (!moving_at(t_s)) return {};
     const double w = 2.0 * M_PI * oscillation_frequency_Hz;
-    return velocity_m_per_s + oscillation_amplitude_m * (w * std::cos(w * t_s));
+    return velocity_m_per_s + oscillation_amplitude_m * (w * std::cos(w * moving_s(t_s)));
 }
 
 void PrescribedMotion::pose(double t_s, Mat3& rotation, Vec3& translation_m) const
 {
     const double speed = norm(angular_velocity_rad_per_s);
-    rotation = speed > 0.0 ? rotation_about_axis(angular_velocity_rad_per_s * (1.0 / speed), speed * t_s)
+    rotation = speed > 0.0 ? rotation_about_axis(angular_velocity_rad_per_s * (1.0 / speed), speed * moving_s(t_s))
                            : Mat3::identity();
     // x_world = c(t) + R (x_b - pivot) = R x_b + (c(t) - R pivot)
     translation_m = pivot_position_m(t_s) - rotation * pivot_m;

@@ -7,6 +7,8 @@
 
 #include <array>
 #include <cstdint>
+#include <algorithm>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,11 +32,19 @@ struct PrescribedMotion {
     Vec3 pivot_m;
     Vec3 oscillation_amplitude_m;
     double oscillation_frequency_Hz = 0.0;
+    /// The motion runs from start_s to end_s: before, the mesh rests where it is at t = 0; after, where the
+    /// motion brought it (a gate that opens at a chosen time and stays open).
+    double start_s = 0.0;
+    double end_s = std::numeric_limits<double>::infinity();
 
+    /// How long the motion has run by time t: 0 before start_s, end_s - start_s after end_s.
+    double moving_s(double t_s) const { return std::min(std::max(t_s, start_s), end_s) - start_s; }
+    bool moving_at(double t_s) const { return t_s >= start_s && t_s < end_s; }
     /// Pose at time t: rotation and translation so that x_world = R x_body + T.
     void pose(double t_s, Mat3& rotation, Vec3& translation_m) const;
-    /// Velocity of the pivot and angular velocity at time t.
+    /// Velocity of the pivot and angular velocity at time t (zero outside [start_s, end_s)).
     Vec3 pivot_velocity_m_per_s(double t_s) const;
+    Vec3 angular_velocity_at(double t_s) const { return moving_at(t_s) ? angular_velocity_rad_per_s : Vec3{}; }
     Vec3 pivot_position_m(double t_s) const;
 };
 

@@ -79,9 +79,24 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
     plane_wall_id_.push_back(static_cast<std::int32_t>(walls_.size() - 1));
     wall_force_N_.resize(walls_.size());
     wall_torque_N_m_.resize(walls_.size());
+    wall_removed_.push_back(0);
     rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
+}
+
+void World::remove_wall(int wall_id)
+{
+    is_mesh(wall_id);  // validates the id
+    if (wall_removed_[static_cast<std::size_t>(wall_id)]) return;
+    wall_removed_[static_cast<std::size_t>(wall_id)] = 1;
+    rebuild_needed_ = true;  // its candidates go with the next step's rebuild, and with them its contacts
+}
+
+bool World::wall_removed(int wall_id) const
+{
+    is_mesh(wall_id);
+    return wall_removed_[static_cast<std::size_t>(wall_id)] != 0;
 }
 
 int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std::string& name,
@@ -94,6 +109,9 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
                     is_finite(motion->pivot_m) && is_finite(motion->oscillation_amplitude_m) &&
                     std::isfinite(motion->oscillation_frequency_Hz)))
         throw InputError(concat("prescribed motion of mesh '", name, "' must be finite"));
+    if (motion && !(motion->start_s >= 0.0 && std::isfinite(motion->start_s) && motion->end_s > motion->start_s))
+        throw InputError(concat("prescribed motion of mesh '", name, "' runs from ", motion->start_s, " s to ", motion->end_s,
+                                " s; expected a finite start >= 0 and an end after it"));
     meshes_.emplace_back(std::move(mesh), material, name, motion);
     if (motion) {
         // place the mesh at the current time
@@ -101,7 +119,7 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
         Vec3 t;
         motion->pose(time_s_, r, t);
         meshes_.back().set_pose(r, t, motion->pivot_position_m(time_s_), motion->pivot_velocity_m_per_s(time_s_),
-                                motion->angular_velocity_rad_per_s);
+                                motion->angular_velocity_at(time_s_));
     }
     walls_.push_back({true, static_cast<int>(meshes_.size() - 1)});
     wall_names_.insert(name);
@@ -109,6 +127,7 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
     mesh_moved_.push_back(1);
     wall_force_N_.resize(walls_.size());
     wall_torque_N_m_.resize(walls_.size());
+    wall_removed_.push_back(0);
     rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
@@ -394,7 +413,7 @@ void World::move_prescribed_meshes(double t_end_s, double dt_s)
         motion.pose(t_end_s, r, t);
         // the rigid velocity field at mid-step, referred to the pivot's position at the end of the step
         const Vec3 mid_velocity = motion.pivot_velocity_m_per_s(t_end_s - 0.5 * dt_s);
-        m.set_pose(r, t, motion.pivot_position_m(t_end_s), mid_velocity, motion.angular_velocity_rad_per_s);
+        m.set_pose(r, t, motion.pivot_position_m(t_end_s), mid_velocity, motion.angular_velocity_at(t_end_s - 0.5 * dt_s));
     }
 }
 
@@ -697,6 +716,7 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
     };
     for (std::size_t m = 0; m < meshes_.size(); ++m) {
         const MeshWall& mw = meshes_[m];
+        if (wall_removed_[static_cast<std::size_t>(mesh_wall_id_[m])]) continue;
         if (mw.convex()) {
             const Vec3 centre = mw.bound_centre_world_m();
             const double radius = mw.bound_radius_m();
@@ -745,7 +765,7 @@ void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3]
             const auto cid = static_cast<std::size_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
             const double range = particles_.radius_m[i] + skin_m_;
             for (std::size_t q = 0; q < planes_.size(); ++q)
-                if (dot(p, planes_[q].normal) - plane_offset_m_[q] < range) {
+                if (dot(p, planes_[q].normal) - plane_offset_m_[q] < range && !wall_removed_[static_cast<std::size_t>(plane_wall_id_[q])]) {
                     out.push_back({static_cast<std::uint32_t>(q), kPlaneCandidate});
                     ++counts[i];
                 }
@@ -1725,6 +1745,7 @@ void World::write_state(StateWriter& out) const
     out.value<std::uint8_t>(prepared_);
     out.value<std::uint8_t>(rebuild_needed_);
     out.value<std::uint8_t>(step_checked_);
+    out.array(wall_removed_);
     out.tag("mesh-poses");
     for (const MeshWall& m : meshes_) {
         out.value(m.rotation());
@@ -1791,6 +1812,8 @@ void World::read_state(StateReader& in)
     prepared_ = in.value<std::uint8_t>() != 0;
     rebuild_needed_ = in.value<std::uint8_t>() != 0;
     step_checked_ = in.value<std::uint8_t>() != 0;
+    in.array(wall_removed_);
+    if (wall_removed_.size() != walls_.size()) in.fail("a removed-wall flag for each wall");
     in.tag("mesh-poses");
     for (MeshWall& m : meshes_) {
         const auto rotation = in.value<Mat3>();

@@ -70,6 +70,10 @@ public:
     /// Moves a mesh wall rigidly (used by code that drives machine parts); takes effect for the next step.
     void set_mesh_pose(int wall_id, const Mat3& rotation, const Vec3& translation_m, const Vec3& reference_point_m,
                        const Vec3& reference_velocity_m_per_s, const Vec3& angular_velocity_rad_per_s);
+    /// Takes a wall out of the world from the next step on: no sphere touches it again (a gate opened, a plug
+    /// pulled). Its force reads zero from then; its name and id stay.
+    void remove_wall(int wall_id);
+    bool wall_removed(int wall_id) const;
     /// Mass of the body behind a mesh wall (0: immovable), for the damping's effective mass.
     void set_wall_mass_kg(int wall_id, double mass_kg);
     /// Receives every sphere-wall contact of each step (see core/contact_record.h).
@@ -251,6 +255,7 @@ private:
     std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
     std::vector<std::uint8_t> mesh_moved_;    ///< beside meshes_: posed or given a mass since the last wall phase
     std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
+    std::vector<std::uint8_t> wall_removed_;  ///< per wall id: 1 once remove_wall took it out
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
 

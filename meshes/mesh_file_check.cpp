@@ -17,7 +17,11 @@ namespace dipper::meshes {
 
 namespace {
 
-/// Whitespace-separated words of a text with the line each starts on.
+/// Space, tab and line ends: the separators every reader agrees on (a form feed between two numbers was
+/// one separator here and none for assimp, which then aborted).
+bool separator(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+/// Words between separators, with the line each starts on.
 class Words {
 public:
     Words(const std::string& text, std::size_t start, std::size_t line) : text_(text), pos_(start), line_(line) {}
@@ -25,13 +29,13 @@ public:
     /// The next word, or false at the end of the text.
     bool next(std::string& word)
     {
-        while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) {
+        while (pos_ < text_.size() && separator(text_[pos_])) {
             if (text_[pos_] == '\n') ++line_;
             ++pos_;
         }
         if (pos_ >= text_.size()) return false;
         const std::size_t begin = pos_;
-        while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+        while (pos_ < text_.size() && !separator(text_[pos_])) ++pos_;
         word.assign(text_, begin, pos_ - begin);
         return true;
     }
@@ -204,11 +208,10 @@ MeshFileSummary check_ply(const std::string& path, const std::string& bytes)
     std::vector<PlyElement> elements;
     bool ended = false;
     while (pos < bytes.size() && !ended) {
-        const std::size_t eol = bytes.find('\n', pos);
+        const std::size_t eol = bytes.find_first_of("\r\n", pos);  // CR, LF or CR LF end a line
         if (eol == std::string::npos) refuse(path, s.format, at_line(line + 1), "the header ends without 'end_header'");
         std::string text = bytes.substr(pos, eol - pos);
-        if (!text.empty() && text.back() == '\r') text.pop_back();
-        pos = eol + 1;
+        pos = eol + (bytes.compare(eol, 2, "\r\n") == 0 ? 2 : 1);
         ++line;
         std::vector<std::string> w;
         Words words(text, 0, line);
@@ -308,7 +311,7 @@ MeshFileSummary check_ply(const std::string& path, const std::string& bytes)
                 do {
                     if (at >= bytes.size())
                         refuse(path, s.format, at_line(row + 1), concat("the file ends in ", e.name, " ", k, " of ", e.count, ": it is cut short"));
-                    std::size_t eol = bytes.find('\n', at);
+                    std::size_t eol = bytes.find_first_of("\r\n", at);  // a lone CR ends a line too, for readers
                     if (eol == std::string::npos) eol = bytes.size();
                     text = bytes.substr(at, eol - at);
                     at = eol + 1;

@@ -8,7 +8,8 @@ const std::vector<KeySpec>& scenario_keys()
         {"dipper_scenario", "integer", "required", "format version of the file; 1"},
         {"name", "string", "none", "name of the run in reports; the file name without extension if absent"},
         {"seed", "integer", "1", "seed of every random choice (fills, pours); same seed, same run"},
-        {"threads", "integer", "0", "OpenMP threads of the spheres, the coupling and Bullet's narrow phase; 0 takes OMP_NUM_THREADS or all cores"},
+        {"threads", "integer", "0", "OpenMP threads of the spheres, the coupling and Bullet's narrow phase; 0 takes OMP_NUM_THREADS or all cores. "
+                                        "The rigid bodies' result is the same on any count; the spheres' parallel sums make a run's bits depend on it"},
         {"gravity_m_per_s2", "vector3", "[0, 0, -9.81]", "gravitational acceleration"},
 
         {"time", "map", "required", "time stepping"},
@@ -47,6 +48,7 @@ const std::vector<KeySpec>& scenario_keys()
         {"planes[].point_m", "vector3", "required", "a point on the plane"},
         {"planes[].normal", "vector3", "required", "towards the side the particles are on; normalised"},
         {"planes[].material", "string", "required", "surface material"},
+        {"planes[].removed_at_s", "number", "none", "time from which no sphere touches the plane (a gate opened); spheres only, not with rocks or the shovel"},
 
         {"meshes", "list", "[]", "triangle-mesh walls from files (STL, OBJ, PLY) or generated machine parts"},
         {"meshes[].name", "string", "required", "unique wall name (used in outputs)"},
@@ -63,6 +65,9 @@ const std::vector<KeySpec>& scenario_keys()
         {"meshes[].motion.pivot_m", "vector3", "[0, 0, 0]", "the point that moves and that the mesh turns about, at t = 0"},
         {"meshes[].motion.oscillation_amplitude_m", "vector3", "[0, 0, 0]", "A in pivot + v t + A sin(2 pi f t)"},
         {"meshes[].motion.oscillation_frequency_Hz", "number", "0", "f of the oscillation"},
+        {"meshes[].motion.start_s", "number", "0", "the motion starts then (t in the formulas counts from it); before, the mesh rests at its t = 0 pose"},
+        {"meshes[].motion.end_s", "number", "none", "the motion stops then and the mesh stays where it was brought"},
+        {"meshes[].removed_at_s", "number", "none", "time from which no sphere touches the mesh (a plug pulled); spheres only, not with rocks or the shovel"},
 
         {"pile", "string", "none",
          "a saved pile (output.pile_file of an earlier run), relative to this file: its spheres and rocks are placed at t = 0, "

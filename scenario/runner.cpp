@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "dipper-checkpoint 4";
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 5";
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int signal) { g_signal = signal; }
@@ -226,8 +226,18 @@ public:
             throw InputError(concat("--stop-after ", options_.stop_after_s, " s: the run is already at t = ", world_->time_s(),
                                     " s; give a later time"));
         require_reasonable_step_count(end_s - world_->time_s(), dt);
+        // walls taken out at their removed_at_s (build_world adds the planes, then the meshes, first)
+        const auto remove_walls_due = [&] {
+            for (std::size_t k = 0; k < scenario_.planes.size() + scenario_.meshes.size(); ++k) {
+                const bool plane = k < scenario_.planes.size();
+                const double at = plane ? scenario_.planes[k].removed_at_s : scenario_.meshes[k - scenario_.planes.size()].removed_at_s;
+                const int id = static_cast<int>(k);
+                if (std::isfinite(at) && !world_->wall_removed(id) && reached(at)) world_->remove_wall(id);
+            }
+        };
         try {
             while (!reached(end_s)) {
+                remove_walls_due();
                 const std::uint64_t before = world_->step_count();
                 if (rigid_) {
                     rigid_->step();

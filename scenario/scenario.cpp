@@ -286,6 +286,15 @@ void read_box(const MapReader& r, Vec3& lo, Vec3& hi, const char* lo_key, const 
                    concat("each coordinate above ", lo_key, " [", lo.x, ", ", lo.y, ", ", lo.z, "]"));
 }
 
+/// A wall's removed_at_s: when it stops touching spheres; infinite when the key is absent.
+double removal_time(const MapReader& r)
+{
+    if (!r.has("removed_at_s")) return std::numeric_limits<double>::infinity();
+    const double t = r.number("removed_at_s");
+    require_non_negative(t, "removed_at_s", r.where("removed_at_s"));
+    return t;
+}
+
 void read_materials(const MapReader& top, Scenario& s)
 {
     const MapReader m = top.map("materials");
@@ -607,6 +616,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         if (!(norm(plane.normal) > 0.0)) p.fail("normal", "[0, 0, 0]", "a non-zero vector");
         plane.normal = plane.normal * (1.0 / norm(plane.normal));
         plane.material = material_known(s, p, "material", true);
+        plane.removed_at_s = removal_time(p);
         s.planes.push_back(plane);
     }
     for (const MapReader& m : top.maps("meshes")) {
@@ -639,8 +649,16 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
             motion.oscillation_amplitude_m = mo.vector3("oscillation_amplitude_m");
             motion.oscillation_frequency_Hz = mo.number("oscillation_frequency_Hz");
             require_non_negative(motion.oscillation_frequency_Hz, "oscillation_frequency_Hz", mo.where("oscillation_frequency_Hz"));
+            motion.start_s = mo.number("start_s");
+            require_non_negative(motion.start_s, "start_s", mo.where("start_s"));
+            if (mo.has("end_s")) {
+                motion.end_s = mo.number("end_s");
+                if (!(motion.end_s > motion.start_s))
+                    mo.fail("end_s", concat(motion.end_s), concat("a time after start_s (", motion.start_s, " s)"));
+            }
             mesh.motion = motion;
         }
+        mesh.removed_at_s = removal_time(m);
         s.meshes.push_back(mesh);
     }
     // wall names are unique across planes and meshes
@@ -792,6 +810,17 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         s.output.pile_file = *file;
     }
     s.output.pile_cut_above_m = out.number("pile_cut_above_m");
+    // a wall taken out is taken out of the spheres' world; Bullet's copy for rocks and the machine stays
+    if (s.uses_coupling()) {
+        for (std::size_t k = 0; k < s.planes.size(); ++k)
+            if (std::isfinite(s.planes[k].removed_at_s))
+                throw InputError(concat(s.source, ": planes[", k, "].removed_at_s: walls are removed for spheres only; this scenario has "
+                                        "rocks, the shovel, wear surfaces or a pile, whose walls cannot be removed"));
+        for (std::size_t k = 0; k < s.meshes.size(); ++k)
+            if (std::isfinite(s.meshes[k].removed_at_s))
+                throw InputError(concat(s.source, ": meshes[", k, "].removed_at_s: walls are removed for spheres only; this scenario has "
+                                        "rocks, the shovel, wear surfaces or a pile, whose walls cannot be removed"));
+    }
     return s;
 }
 

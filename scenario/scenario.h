@@ -10,6 +10,7 @@
 #include "dem/world.h"
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +21,7 @@ namespace dipper::scenario {
 struct PlaneSpec {
     std::string name, material;
     Vec3 point_m, normal;
+    double removed_at_s = std::numeric_limits<double>::infinity();  ///< from then on no sphere touches it
 };
 
 struct MeshSpec {
@@ -30,6 +32,7 @@ struct MeshSpec {
     Vec3 rotate_deg;
     Vec3 translate_m;
     std::optional<dem::PrescribedMotion> motion;
+    double removed_at_s = std::numeric_limits<double>::infinity();  ///< from then on no sphere touches it
     std::string where;                 ///< file:line:col of the entry, for errors found when loading the mesh
 };
 

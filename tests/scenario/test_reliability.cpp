@@ -243,3 +243,63 @@ TEST_CASE("a pile dipper settled and saved loads again with the overlaps it was 
     REQUIRE(std::stod(cell) > 0.01);
     CHECK(run_scenario(load_scenario((dir / "reuse.yaml").string()), (dir / "reused").string(), quiet).status == RunStatus::completed);
 }
+
+TEST_CASE("a gate removed at its time lets a box empty, and a resume across the removal keeps the bits", "[scenario][walls][unit]")
+{
+    const std::string text = R"(dipper_scenario: 1
+name: gate
+seed: 4
+threads: 1
+time: {duration_s: 1.0}
+planes:
+  - {name: floor, point_m: [0, 0, -3], normal: [0, 0, 1], material: ground}
+  - {name: x0, point_m: [0, 0, 0], normal: [1, 0, 0], material: steel}
+  - {name: x1, point_m: [1, 0, 0], normal: [-1, 0, 0], material: steel}
+  - {name: y0, point_m: [0, 0, 0], normal: [0, 1, 0], material: steel}
+  - {name: y1, point_m: [0, 1, 0], normal: [0, -1, 0], material: steel}
+  - {name: gate, point_m: [0, 0, 0], normal: [0, 0, 1], material: steel, removed_at_s: 0.3}
+fills:
+  - {mass_kg: 300, box: {min_m: [0, 0, 0], max_m: [1, 1, 0.8]}, sizes: [{radius_m: 0.1, mass_fraction: 1.0}]}
+probes:
+  regions:
+    - {name: box, min_m: [0, 0, 0], max_m: [1, 1, 2]}
+output: {vtk_interval_s: 0, csv_interval_s: 0.05}
+)";
+    const fs::path dir = fs::temp_directory_path() / "dipper_gate";
+    fs::remove_all(dir);
+    RunOptions quiet;
+    quiet.progress = false;
+    const Scenario s = parse_scenario(text, "gate.yaml", ".");
+    REQUIRE(run_scenario(s, (dir / "whole").string(), quiet).status == RunStatus::completed);
+    // the box's mass: all of it until the gate goes at 0.3 s, none 0.7 s later (a sphere at rest falls 2.4 m)
+    const std::string csv = test::read_text_file((dir / "whole" / "probes.csv").string());
+    const auto box_mass_at = [&](const std::string& time) {
+        const std::size_t row = csv.find("\n" + time);
+        REQUIRE(row != std::string::npos);
+        const std::string line = csv.substr(row + 1, csv.find('\n', row + 1) - row - 1);
+        std::stringstream cells(line);
+        std::string cell;
+        for (int c = 0; c < 8 + 3 * 6 + 1; ++c) std::getline(cells, cell, ',');  // 8 columns, 6 walls x 3, the region
+        return std::stod(cell);
+    };
+    const double filled = box_mass_at("0.25");
+    CHECK(filled > 280.0);
+    CHECK(box_mass_at("0.3") == filled);
+    const std::string summary = test::read_text_file((dir / "whole" / "summary.json").string());
+    CHECK_THAT(summary, Contains("\"region_mass_kg\": {\"box\": 0}"));
+    // stopped before and after the removal, resumed: the uninterrupted run's state
+    for (const double stop : {0.2, 0.5}) {
+        RunOptions o = quiet;
+        o.stop_after_s = stop;
+        const std::string legs = (dir / concat("legs_", stop)).string();
+        REQUIRE(run_scenario(s, legs, o).status == RunStatus::interrupted);
+        REQUIRE(resume_run(legs, quiet).status == RunStatus::completed);
+        const std::string resumed = test::read_text_file(legs + "/summary.json");
+        const auto hash = [](const std::string& j) { return j.substr(j.find("\"state_hash\""), 32); };
+        CHECK(hash(resumed) == hash(summary));
+    }
+    // not with rocks or the shovel: Bullet keeps its copy of the walls
+    CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex("fills:\n.*\n"), "fills:\n  - {mass_kg: 300, box: {min_m: [0, 0, 0], max_m: [1, 1, 0.8]}, "
+                                                                                     "sizes: [{radius_m: 0.1, mass_fraction: 0.5}], rocks: [{size_m: 0.3, mass_fraction: 0.5}]}\n")),
+               Contains("planes[5].removed_at_s: walls are removed for spheres only"));
+}
