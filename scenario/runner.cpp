@@ -570,13 +570,15 @@ private:
         std::string cause;
         if (scenario_.step_s > 0.0) {
             cause = concat("time.step_s = ", dt, " s");
-        } else {
+        } else if (world_->step_setting_particle() < world_->particles().size()) {
             const std::size_t i = world_->step_setting_particle();
             const dem::ParticleStore& p = world_->particles();
             const dem::Material& m = world_->materials().material(p.material[i]);
             cause = concat("the default step ", dt, " s, set by particle ", p.id[i], " (radius ", p.radius_m[i], " m, material '",
                            m.name, "', ", p.mass_kg[i], " kg, stiffest contact ", world_->stiffest_contact_N_per_m(i),
                            " N/m: check its radius, the material's Young's modulus and the C_norm of its pairs)");
+        } else {
+            cause = concat("a step of ", dt, " s");
         }
         throw InputError(concat(scenario_.source, ": ", span_s, " s of simulated time is ", steps, " steps at ", cause,
                                 "; a run takes at most ", kMaxSteps, " steps"));
@@ -822,6 +824,14 @@ void check_scenario(const Scenario& s)
         require_spheres_at_start(s, *world);
     }
     require_run_fits(s, *world);
+    // more than 10^9 steps is a mistake in a stiffness, a radius or the step (the run refuses it too, naming
+    // the particle that sets the step)
+    constexpr double kMaxSteps = 1e9;
+    const double step = planned_step_s(s, *world);
+    if (std::isfinite(step) && step > 0.0 && s.duration_s / step > kMaxSteps)
+        throw InputError(concat(s.source, ": time.duration_s = ", s.duration_s, " s is ", s.duration_s / step, " steps of ", step,
+                                " s (", s.step_s > 0.0 ? "time.step_s" : "the default step of the smallest, stiffest sphere",
+                                "); a run takes at most ", kMaxSteps, " steps: check the radii, the Young's moduli and the pairs' C_norm"));
 }
 
 RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)

@@ -111,6 +111,10 @@ TEST_CASE("output intervals shorter than the step are refused by check and run (
         REQUIRE(text != settle_box());
         CHECK_THAT(check_error(text), Contains(concat("output.", name, ": got 1e-17; expected at least the time step, 4.31")));
     }
+    // and a step count past 10^9 is refused by check as by run (C_norm 1e30: a step of about 1e-20 s)
+    CHECK_THAT(check_error(std::regex_replace(settle_box(), std::regex("  preset: aitik_copper_ore\n"),
+                                              "  preset: aitik_copper_ore\n  pairs:\n    - {materials: [ore, ground], normal_stiffness_scale: 1e30}\n")),
+               Contains("case.yaml: time.duration_s = 0.02 s is") && Contains("a run takes at most 1000000000 steps"));
     // the step itself is what the run takes: 0.15 sqrt(m/k) of the 0.1 m ore sphere against its stiffest pair
     const Scenario s = parse_scenario(settle_box(), "case.yaml", ".");
     const auto world = build_world(s);
