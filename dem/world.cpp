@@ -33,7 +33,8 @@ World::World(MaterialTable materials, WorldSettings settings) : materials_(std::
     require_positive(settings_.skin_fraction_of_radius, "skin_fraction_of_radius", at);
     require_in_range(settings_.max_overlap_ratio, 1e-6, 1.0, "max_overlap_ratio", at);
     require_in_range(settings_.initial_overlap_tolerance, 0.0, 1.0, "initial_overlap_tolerance", at);
-    if (settings_.threads < 0) throw InputError(concat("threads must be >= 0; got ", settings_.threads, " (", at, ")"));
+    if (settings_.threads < 0 || settings_.threads > 1024)
+        throw InputError(concat("threads must be 0 (all cores) to 1024; got ", settings_.threads, " (", at, ")"));
     threads_ = settings_.threads > 0 ? settings_.threads : omp_get_max_threads();
     for (std::size_t m = 0; m < materials_.size(); ++m)
         bulk_modulus_Pa_.push_back(materials_.material(static_cast<MaterialIndex>(m)).is_surface

@@ -860,6 +860,7 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
     in->tag("run");
     const std::string text = in->text(), source = in->text(), base_dir = in->text();
     const int threads = in->value<std::int32_t>();
+    if (threads < 1 || threads > 1024) in->fail(concat("a thread count of ", threads, "; expected 1 to 1024"));
     Scenario scenario = parse_scenario(text, source, base_dir);
     RunOptions o = options;
     if (o.threads <= 0) o.threads = threads;  // same thread count, same bits
