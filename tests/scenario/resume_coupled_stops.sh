@@ -4,6 +4,7 @@
 # ended run adds no row to probes.csv. SIGKILL is kill_resume.sh's.
 # usage: resume_coupled_stops.sh DIPPER SCENARIO WORKDIR COMPARE...
 set -euo pipefail
+source "$(dirname "$0")/interrupt.sh"
 dipper=$1 scenario=$2 work=$3
 shift 3
 rm -rf "$work" && mkdir -p "$work"
@@ -15,19 +16,9 @@ rc=0
 "$dipper" resume "$work/stopped" --quiet > "$work/stopped.log" 2>&1 || { echo "FAIL: resume after --stop-after"; cat "$work/stopped.log"; exit 1; }
 "$@" "$work/whole" "$work/stopped"
 
-"$dipper" run "$scenario" --out "$work/interrupted" --quiet > /dev/null 2>&1 &
-pid=$!
 # after the second checkpoint (0.2 s), as kill_resume.sh: a stop while the rocks are still landing on the
 # dipper (0.05-0.1 s) lets single spheres part by 120-240 mm by 0.3 s (median 0), beyond the limits
-for _ in $(seq 1 1200); do
-  [ -f "$work/interrupted/checkpoint.prev.bin" ] && break
-  sleep 0.02
-done
-kill -INT "$pid" 2> /dev/null || { echo "FAIL: the run ended before SIGINT"; exit 1; }
-rc=0
-wait "$pid" || rc=$?
-[ "$rc" = 130 ] || { echo "FAIL: the run exited $rc after SIGINT, expected 130"; exit 1; }
-"$dipper" resume "$work/interrupted" --quiet > "$work/interrupted.log" 2>&1 || { echo "FAIL: resume after SIGINT"; cat "$work/interrupted.log"; exit 1; }
+interrupt_and_resume "$dipper" "$scenario" "$work/interrupted" checkpoint.prev.bin
 "$@" "$work/whole" "$work/interrupted"
 
 rows=$(wc -l < "$work/whole/probes.csv")

@@ -5,6 +5,7 @@
 # (which appended its last row again).
 # usage: resume_every_stop.sh DIPPER SCENARIO WORKDIR
 set -euo pipefail
+source "$(dirname "$0")/interrupt.sh"
 dipper=$1 scenario=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 hash() { sed -n 's/.*"state_hash": "\([0-9a-f]*\)".*/\1/p' "$1/summary.json"; }
@@ -32,18 +33,7 @@ done
 "$dipper" resume "$work/stopped" --quiet > "$work/stopped.log" 2>&1 || { echo "FAIL: the last resume"; cat "$work/stopped.log"; exit 1; }
 same_as_whole "$work/stopped" "stopped at four steps while pouring and resumed"
 
-"$dipper" run "$scenario" --out "$work/interrupted" --quiet > /dev/null 2>&1 &
-pid=$!
-for _ in $(seq 1 1200); do
-  [ -f "$work/interrupted/checkpoint.bin" ] && break
-  sleep 0.02
-done
-kill -INT "$pid" 2> /dev/null || { echo "FAIL: the run ended before SIGINT"; exit 1; }
-rc=0
-wait "$pid" || rc=$?
-[ "$rc" = 130 ] || { echo "FAIL: the run exited $rc after SIGINT, expected 130"; exit 1; }
-"$dipper" resume "$work/interrupted" --quiet > "$work/interrupted.log" 2>&1 ||
-  { echo "FAIL: resume after SIGINT"; cat "$work/interrupted.log"; exit 1; }
+interrupt_and_resume "$dipper" "$scenario" "$work/interrupted" checkpoint.bin
 same_as_whole "$work/interrupted" "stopped by SIGINT and resumed"
 
 rows=$(wc -l < "$work/whole/probes.csv")
