@@ -108,6 +108,19 @@ void ParticleStore::read_state(StateReader& in, const MaterialTable& materials)
     if (material.size() != n || id.size() != n) in.fail("particle arrays of different lengths");
     for (MaterialIndex m : material)
         if (m >= materials.size()) in.fail(concat("particle material ", m, " beyond the ", materials.size(), " materials"));
+    // what a run wrote is finite and physical; a file changed behind its checksum must not reach the grid
+    // (a NaN position made the neighbour grid's size undefined)
+    for (const auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m})
+        for (const Vec3& x : *v)
+            if (!is_finite(x)) in.fail("a particle vector that is not finite");
+    for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2})
+        for (double x : *v)
+            if (!(x > 0.0 && std::isfinite(x))) in.fail(concat("a particle radius, mass or inverse of ", x, "; expected a finite value > 0"));
+    std::vector<std::uint8_t> seen(next_id_, 0);
+    for (std::uint32_t i : id) {
+        if (i >= next_id_ || seen[i]) in.fail(concat("particle id ", i, " repeated or not below the next id ", next_id_));
+        seen[i] = 1;
+    }
 }
 
 }  // namespace dipper::dem

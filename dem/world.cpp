@@ -1808,6 +1808,8 @@ void World::read_state(StateReader& in)
     particles_.read_state(in, materials_);
     time_s_ = in.value<double>();
     step_s_ = in.value<double>();
+    if (!(time_s_ >= 0.0 && std::isfinite(time_s_)) || !(step_s_ >= 0.0 && std::isfinite(step_s_)))
+        in.fail(concat("a time of ", time_s_, " s or a step of ", step_s_, " s"));
     step_count_ = in.value<std::uint64_t>();
     rebuild_count_ = in.value<std::uint64_t>();
     prepared_ = in.value<std::uint8_t>() != 0;
@@ -1823,8 +1825,14 @@ void World::read_state(StateReader& in)
         const auto velocity = in.value<Vec3>();
         const auto spin = in.value<Vec3>();
         const auto version = in.value<std::uint64_t>();
+        bool finite = is_finite(translation) && is_finite(reference) && is_finite(velocity) && is_finite(spin);
+        for (const auto& row : rotation.m)
+            for (double x : row) finite = finite && std::isfinite(x);
+        if (!finite) in.fail(concat("a pose of mesh '", m.name(), "' that is not finite"));
         m.restore_pose(rotation, translation, reference, velocity, spin, version);
-        m.set_mass_kg(in.value<double>());
+        const double mass = in.value<double>();
+        if (!(mass >= 0.0 && std::isfinite(mass))) in.fail(concat("a mass of ", mass, " kg for mesh '", m.name(), "'"));
+        m.set_mass_kg(mass);
     }
     std::fill(mesh_moved_.begin(), mesh_moved_.end(), 1);
     in.tag("neighbours");
@@ -1840,6 +1848,7 @@ void World::read_state(StateReader& in)
     in.array(reference_mesh_version_);
     if (reference_mesh_rotation_.size() > meshes_.size()) in.fail("more mesh references than meshes");
     skin_m_ = in.value<double>();
+    if (!(skin_m_ >= 0.0 && std::isfinite(skin_m_))) in.fail(concat("a neighbour skin of ", skin_m_, " m"));
     in.tag("wall-contacts");
     in.array(wall_contacts_);
     in.array(wall_contact_start_);

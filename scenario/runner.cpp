@@ -184,6 +184,7 @@ public:
             }
         }
         in.finish();
+        require_run_fits(scenario_, *world_);  // the scenario inside a checkpoint is checked as a file is
         open_outputs(true, csv_bytes);
         std::size_t k = 0;
         particles_pvd_->restore(entries[k++]);
@@ -249,9 +250,10 @@ public:
                     for (dem::Pourer& p : pourers_) p.update(*world_);
                 // each schedule moves past now; an interval too short to move it is refused before the run
                 const auto advance = [&](double& next, double interval) {
-                    while (reached(next)) {
-                        if (!(next + interval > next))
-                            throw InputError(concat("an output interval of ", interval, " s cannot advance past t = ", next, " s"));
+                    for (int k = 0; reached(next); ++k) {
+                        if (k > 1000 || !(next + interval > next))
+                            throw InputError(concat("an output interval of ", interval, " s cannot keep up with the step of ", dt,
+                                                    " s at t = ", next, " s"));
                         next += interval;
                     }
                 };

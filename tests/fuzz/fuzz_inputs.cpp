@@ -1,5 +1,6 @@
 // A seeded mutation fuzzer of what dipper reads from users' files: scenario files (read and checked as
-// `dipper check` does), mesh files (STL, OBJ, PLY) and checkpoints (resumed for a few steps). Each input
+// `dipper check` does), mesh files (STL, OBJ, PLY), checkpoints (resumed for 1 ms) and saved piles (a
+// scenario started from them for 1 ms). Each input
 // is a corpus file changed by a few random edits: bytes flipped, spans cut, repeated or moved, the file
 // truncated, a number replaced by an extreme one (0, -1, 1e-17, 1e300, nan, a count of 10^11); a changed
 // checkpoint mostly gets its checksum made to match.
@@ -35,7 +36,7 @@ using namespace dipper;
 
 namespace {
 
-enum class Kind { scenario, mesh, checkpoint };
+enum class Kind { scenario, mesh, checkpoint, pile };
 
 struct Seed {
     Kind kind;
@@ -150,6 +151,16 @@ void exercise(Kind kind, const fs::path& file, const fs::path& work, const std::
         scenario::resume_run(work.string(), quiet);
         break;
     }
+    case Kind::pile: {
+        fs::remove_all(work);
+        const std::string text = "dipper_scenario: 1\nthreads: 1\ntime: {duration_s: 0.001}\nplanes:\n"
+                                 "  - {name: floor, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}\n"
+                                 "pile: " + file.filename().string() + "\noutput: {vtk_interval_s: 0}\n";
+        scenario::RunOptions quiet;
+        quiet.progress = false;
+        scenario::run_scenario(scenario::parse_scenario(text, "pile_fuzz.yaml", file.parent_path().string()), work.string(), quiet);
+        break;
+    }
     }
     (void)extension;
 }
@@ -181,14 +192,14 @@ int main(int argc, char** argv)
     fs::create_directories(out);
     std::signal(SIGALRM, on_alarm);
 
-    // the corpus: scenario files (*.yaml), mesh files (*.stl, *.obj, *.ply) and checkpoints (*/checkpoint.bin
-    // beside the probes.csv of their run)
+    // the corpus: scenario files (*.yaml), mesh files (*.stl, *.obj, *.ply), checkpoints (*/checkpoint.bin
+    // beside the probes.csv of their run) and saved piles (*.txt)
     std::vector<Seed> seeds;
     for (const auto& entry : fs::recursive_directory_iterator(corpus)) {
         if (!entry.is_regular_file()) continue;
         const std::string ext = entry.path().extension().string();
-        const Kind kind = ext == ".yaml" ? Kind::scenario : ext == ".bin" ? Kind::checkpoint : Kind::mesh;
-        if (ext != ".yaml" && ext != ".bin" && ext != ".stl" && ext != ".obj" && ext != ".ply") continue;
+        const Kind kind = ext == ".yaml" ? Kind::scenario : ext == ".bin" ? Kind::checkpoint : ext == ".txt" ? Kind::pile : Kind::mesh;
+        if (ext != ".yaml" && ext != ".bin" && ext != ".txt" && ext != ".stl" && ext != ".obj" && ext != ".ply") continue;
         seeds.push_back({kind, entry.path().string(), read_bytes(entry.path())});
     }
     std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) { return a.name < b.name; });
@@ -199,8 +210,8 @@ int main(int argc, char** argv)
 
     std::mt19937_64 random(seed);
     const auto start = std::chrono::steady_clock::now();
-    std::size_t tried[3] = {0, 0, 0}, refused[3] = {0, 0, 0}, found = 0;
-    const char* const names[3] = {"scenario", "mesh", "checkpoint"};
+    std::size_t tried[4] = {0, 0, 0, 0}, refused[4] = {0, 0, 0, 0}, found = 0;
+    const char* const names[4] = {"scenario", "mesh", "checkpoint", "pile"};
     for (std::uint64_t n = 0;; ++n) {
         if (replay.empty() && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > seconds) break;
         if (!replay.empty() && n > 0) break;
@@ -208,7 +219,8 @@ int main(int argc, char** argv)
         const Seed& base = !replay.empty() ? seeds.front() : seeds[n < seeds.size() ? n : random() % seeds.size()];
         const Kind kind = replay.empty() ? base.kind
                                          : (fs::path(replay).extension() == ".yaml" ? Kind::scenario
-                                            : fs::path(replay).extension() == ".bin" ? Kind::checkpoint : Kind::mesh);
+                                            : fs::path(replay).extension() == ".bin" ? Kind::checkpoint
+                                            : fs::path(replay).extension() == ".txt" ? Kind::pile : Kind::mesh);
         std::string bytes = !replay.empty() ? read_bytes(replay) : n < seeds.size() ? base.bytes : mutate(base.bytes, random);
         // a checkpoint's checksum catches nearly every change; three times in four it is made to match, so
         // that what the checksum guards is read (as a bug in a writer would have it read)
@@ -242,7 +254,7 @@ int main(int argc, char** argv)
     }
     std::printf("dipper_fuzz_inputs: seed %llu, %zu corpus files, %.0f s:", static_cast<unsigned long long>(seed), seeds.size(),
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    for (int k = 0; k < 3; ++k) std::printf(" %s %zu tried (%zu refused)", names[k], tried[k], refused[k]);
+    for (int k = 0; k < 4; ++k) std::printf(" %s %zu tried (%zu refused)", names[k], tried[k], refused[k]);
     std::printf("; %zu found anything\n", found);
     return found == 0 ? 0 : 1;
 }
