@@ -1,5 +1,5 @@
-// A seeded mutation fuzzer of what dipper reads from users' files: scenario files (read and checked as
-// `dipper check` does), mesh files (STL, OBJ, PLY), checkpoints (resumed for 1 ms) and saved piles (a
+// A seeded mutation fuzzer of what dipper reads from users' files: scenario and sweep files (read and
+// checked as `dipper check` does), mesh files (STL, OBJ, PLY), checkpoints (resumed for 1 ms) and saved piles (a
 // scenario started from them for 1 ms). Each input
 // is a corpus file changed by a few random edits: bytes flipped, spans cut, repeated or moved, the file
 // truncated, a number replaced by an extreme one (0, -1, 1e-17, 1e300, nan, a count of 10^11); a changed
@@ -16,6 +16,7 @@
 #include "meshes/mesh_io.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/sweep.h"
 
 #include <algorithm>
 #include <chrono>
@@ -132,6 +133,11 @@ void exercise(Kind kind, const fs::path& file, const fs::path& work, const std::
 {
     switch (kind) {
     case Kind::scenario: {
+        // a sweep file is read with every variant checked, as `dipper check` does
+        if (read_bytes(file).find("dipper_sweep:") != std::string::npos) {
+            (void)scenario::load_sweep(file.string());
+            break;
+        }
         const scenario::Scenario s = scenario::load_scenario(file.string());
         scenario::check_scenario(s);
         break;
@@ -237,7 +243,9 @@ int main(int argc, char** argv)
         if (replay.empty()) write_bytes(out / "last_input", bytes);  // what a crash leaves behind
         const auto k = static_cast<int>(kind);
         ++tried[k];
-        alarm(input_seconds);
+        // a sweep is checked variant by variant: up to 10,000 of them, 15 s here and more under the sanitizers
+        const bool sweep = kind == Kind::scenario && bytes.find("dipper_sweep:") != std::string::npos;
+        alarm(sweep ? 6 * input_seconds : input_seconds);
         try {
             exercise(kind, input, out / "resume", seed_path.extension().string());
         } catch (const InputError&) {
