@@ -820,7 +820,10 @@ void check_scenario(const Scenario& s)
     if (s.uses_coupling()) RigidScene scene(s, *world);
     // what the run places at t = 0 before its first step, where the step depends on it: the pours due at 0
     // when no fill or pile brings spheres (the same seeds as the run)
-    if (s.step_s == 0.0 && s.pile.empty() && s.fills.empty()) {
+    const bool fills_bring_spheres = std::any_of(s.fills.begin(), s.fills.end(), [](const FillSpec& f) {
+        return std::any_of(f.sizes.classes.begin(), f.sizes.classes.end(), [](const auto& c) { return c.mass_fraction > 0.0; });
+    });
+    if (s.step_s == 0.0 && s.pile.empty() && !fills_bring_spheres) {
         std::vector<dem::Pourer> pourers = make_pourers(s, *world);
         for (dem::Pourer& p : pourers) p.update(*world);
         require_spheres_at_start(s, *world);
