@@ -812,33 +812,6 @@ RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, con
     return run.loop();
 }
 
-void check_scenario(const Scenario& s)
-{
-    const auto world = build_world(s);  // mesh files are read and checked too
-    check_pairs(s);
-    // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
-    if (s.uses_coupling()) RigidScene scene(s, *world);
-    // what the run places at t = 0 before its first step, where the step depends on it: the pours due at 0
-    // when no fill or pile brings spheres (the same seeds as the run)
-    const bool fills_bring_spheres = std::any_of(s.fills.begin(), s.fills.end(), [](const FillSpec& f) {
-        return std::any_of(f.sizes.classes.begin(), f.sizes.classes.end(), [](const auto& c) { return c.mass_fraction > 0.0; });
-    });
-    if (s.step_s == 0.0 && s.pile.empty() && !fills_bring_spheres) {
-        std::vector<dem::Pourer> pourers = make_pourers(s, *world);
-        for (dem::Pourer& p : pourers) p.update(*world);
-        require_spheres_at_start(s, *world);
-    }
-    require_run_fits(s, *world);
-    // more than 10^9 steps is a mistake in a stiffness, a radius or the step (the run refuses it too, naming
-    // the particle that sets the step)
-    constexpr double kMaxSteps = 1e9;
-    const double step = planned_step_s(s, *world);
-    if (std::isfinite(step) && step > 0.0 && s.duration_s / step > kMaxSteps)
-        throw InputError(concat(s.source, ": time.duration_s = ", s.duration_s, " s is ", s.duration_s / step, " steps of ", step,
-                                " s (", s.step_s > 0.0 ? "time.step_s" : "the default step of the smallest, stiffest sphere",
-                                "); a run takes at most ", kMaxSteps, " steps: check the radii, the Young's moduli and the pairs' C_norm"));
-}
-
 RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)
 {
     const fs::path dir(out_dir);

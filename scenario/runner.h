@@ -2,6 +2,7 @@
 // progress lines, checkpoints (at an interval, on SIGINT/SIGTERM and at the end) and resuming from one.
 #pragma once
 
+#include "scenario/run_limits.h"
 #include "scenario/scenario.h"
 
 #include <string>
@@ -25,11 +26,6 @@ struct RunResult {
 
 /// Runs a scenario from t = 0, writing into out_dir (created; files of an earlier run there are replaced).
 RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, const RunOptions& options);
-/// What `dipper check` does past parsing: builds the world with its mesh files and Bullet's side, checks the
-/// material pairs, places the pours due at t = 0 where the time step depends on them, and checks the
-/// intervals against the step and the memory against the machine's; an InputError for what the run
-/// would refuse at its start.
-void check_scenario(const Scenario& scenario);
 /// Continues the run in out_dir from its checkpoint (out_dir/checkpoint.bin, or `checkpoint_file` if given).
 RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file = "");
 

@@ -183,19 +183,6 @@ void check_pairs(const Scenario& scenario);
 /// Places the particles of the fills without rocks (seeded by the scenario's seed and the fill's position
 /// in the list), clear of the walls. Fills with rocks are placed by RigidScene::fill_mixed.
 void build_particles(const Scenario& scenario, dem::World& world);
-/// The time step the run will take: time.step_s, or the default of the stiffest, smallest sphere present
-/// in the world or brought by a fill or pour (infinite when none is known, e.g. before a pile is read).
-double planned_step_s(const Scenario& scenario, const dem::World& world);
-/// The bytes a run of this many spheres holds at most (measured: 0.74 kB per sphere on a loose bed of
-/// 1 and 2 million, plus the longer neighbour lists of a packed bed).
-double run_memory_bytes(double spheres);
-/// Throws an InputError naming the key and value if the run could not go through: an output interval
-/// shorter than the step (at 1e-17 s the schedule stopped advancing and the run hung), or more spheres
-/// than the machine's memory holds (the fills' and pours' count, or the world's when larger).
-void require_run_fits(const Scenario& scenario, const dem::World& world);
-/// Throws an InputError naming the first pour if the world has no sphere once the fills and the pours due
-/// at t = 0 are placed and the scenario sets no time.step_s: the default step comes from the spheres.
-void require_spheres_at_start(const Scenario& scenario, const dem::World& world);
 /// The pours, ready to run from t = 0 (each waits for its start_s).
 std::vector<dem::Pourer> make_pourers(const Scenario& scenario, const dem::World& world);
 

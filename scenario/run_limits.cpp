@@ -1,0 +1,114 @@
+#include "scenario/run_limits.h"
+
+#include "core/errors.h"
+#include "scenario/rigid_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unistd.h>
+
+namespace dipper::scenario {
+
+double planned_step_s(const Scenario& s, const dem::World& world)
+{
+    if (s.step_s > 0.0) return s.step_s;
+    double step = world.particles().size() > 0 ? world.step_s() : std::numeric_limits<double>::infinity();
+    const auto sources = [&](const auto& list) {
+        for (const ParticleSource& p : list) {
+            const dem::MaterialIndex m = world.materials().index_of(p.material);
+            for (const auto& c : p.sizes.classes)
+                if (c.mass_fraction > 0.0) step = std::min(step, world.default_step_s(c.radius_m, m));
+        }
+    };
+    sources(s.fills);
+    sources(s.pours);
+    return step;
+}
+
+double run_memory_bytes(double spheres)
+{
+    constexpr double kBytesPerSphere = 1000.0, kBaseBytes = 64e6;
+    return kBaseBytes + kBytesPerSphere * spheres;
+}
+
+void require_run_fits(const Scenario& s, const dem::World& world)
+{
+    const double step = planned_step_s(s, world);
+    if (std::isfinite(step) && step > 0.0) {
+        const struct {
+            const char* key;
+            double value;
+            const std::string& where;
+        } intervals[] = {{"output.csv_interval_s", s.output.csv_interval_s, s.output.csv_where},
+                         {"output.vtk_interval_s", s.output.vtk_interval_s, s.output.vtk_where},
+                         {"output.checkpoint_interval_s", s.output.checkpoint_interval_s, s.output.checkpoint_where}};
+        for (const auto& i : intervals)
+            if (i.value > 0.0 && i.value < step)
+                throw InputError(concat(i.where.empty() ? concat(s.source, ": ", i.key) : i.where, ": got ", i.value,
+                                        "; expected at least the time step, ", step, " s"));
+    }
+    double spheres = 0.0, most = 0.0;
+    std::string most_where = s.source;
+    const auto count = [&](const auto& list) {
+        for (const ParticleSource& p : list) {
+            const double n = dem::particles_for_mass(p.sizes, s.materials.material(s.materials.index_of(p.material)).density_kg_per_m3,
+                                                     p.mass_kg);
+            spheres += n;
+            if (n > most) most = n, most_where = p.where;
+        }
+    };
+    count(s.fills);
+    count(s.pours);
+    spheres = std::max(spheres, static_cast<double>(world.particles().size()));
+    const double need = run_memory_bytes(spheres);
+    const double have = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+    if (have > 0.0 && need > have)
+        throw InputError(concat(most_where, ": the run's ", std::round(spheres), " spheres (", std::round(most),
+                                " of them here) need about ", std::round(need / 1e8) / 10.0, " GB of memory (",
+                                run_memory_bytes(1.0) - run_memory_bytes(0.0), " bytes each) and this machine has ",
+                                std::round(have / 1e8) / 10.0, " GB; make the fills and pours smaller or the spheres larger"));
+}
+
+void require_spheres_at_start(const Scenario& s, const dem::World& world)
+{
+    if (s.step_s > 0.0 || world.particles().size() > 0 || !s.pile.empty()) return;
+    std::string where = s.source;
+    for (const PourSpec& p : s.pours)
+        if (p.start_s == 0.0) {
+            where = p.where;
+            break;
+        }
+    throw InputError(concat(where, ": no sphere found room in the pour's box at t = 0, and the default time step comes from "
+                                   "the spheres present at t = 0; make the box wider than the largest sphere's diameter by "
+                                   "more (each try draws a centre anywhere in the box) or set time.step_s"));
+}
+
+void check_scenario(const Scenario& s)
+{
+    const auto world = build_world(s);  // mesh files are read and checked too
+    check_pairs(s);
+    // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
+    if (s.uses_coupling()) RigidScene scene(s, *world);
+    // what the run places at t = 0 before its first step, where the step depends on it: the pours due at 0
+    // when no fill or pile brings spheres (the same seeds as the run)
+    const bool fills_bring_spheres = std::any_of(s.fills.begin(), s.fills.end(), [](const FillSpec& f) {
+        return std::any_of(f.sizes.classes.begin(), f.sizes.classes.end(), [](const auto& c) { return c.mass_fraction > 0.0; });
+    });
+    if (s.step_s == 0.0 && s.pile.empty() && !fills_bring_spheres) {
+        std::vector<dem::Pourer> pourers = make_pourers(s, *world);
+        for (dem::Pourer& p : pourers) p.update(*world);
+        require_spheres_at_start(s, *world);
+    }
+    require_run_fits(s, *world);
+    // more than 10^9 steps is a mistake in a stiffness, a radius or the step (the run refuses it too, naming
+    // the particle that sets the step)
+    constexpr double kMaxSteps = 1e9;
+    const double step = planned_step_s(s, *world);
+    if (std::isfinite(step) && step > 0.0 && s.duration_s / step > kMaxSteps)
+        throw InputError(concat(s.source, ": time.duration_s = ", s.duration_s, " s is ", s.duration_s / step, " steps of ", step,
+                                " s (", s.step_s > 0.0 ? "time.step_s" : "the default step of the smallest, stiffest sphere",
+                                "); a run takes at most ", kMaxSteps, " steps: check the radii, the Young's moduli and the pairs' C_norm"));
+}
+
+}  // namespace dipper::scenario
