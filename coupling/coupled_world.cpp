@@ -283,7 +283,6 @@ void CoupledWorld::start()
 {
     const double dt = dem_.step_s();
     if (!(dt > 0.0)) throw InputError("coupling: the DEM has no time step yet (no particles and step_s = 0)");
-    rigid_.set_step_s(dt * settings_.substeps);
     // the reaction of the initial state is the first one Bullet receives
     dem_.prepare();
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
@@ -357,17 +356,27 @@ void CoupledWorld::watch_for_runaways()
     }
 }
 
-void CoupledWorld::exchange(int steps)
+int CoupledWorld::begin_step()
 {
-    // 1. Bullet steps with the spheres' reaction from the last exchange's sub-steps. The body receives in full
-    // the impulse the spheres received there, sum x dt, spread over this step of steps x dt: the sub-steps'
-    // mean force when the two exchanges are equally long, as they are except where the runaway guard starts
-    // or ends a hold. The first step holds the initial state's force. (The per-body loops touch each body's
-    // own data and run on the DEM's threads.)
-    const int threads = dem_.threads();
+    if (checked_bodies_ != bodies_.size()) {
+        check_pairs();
+        checked_bodies_ = bodies_.size();
+    }
+    if (!started_) start();
+    // one exchange of all the coupling step's DEM steps, or, while the runaway guard holds, one per DEM step
+    held_ = settings_.substeps > 1 && hold_steps_ > 0;
+    return held_ ? 1 : settings_.substeps;
+}
+
+double CoupledWorld::send_reactions(int steps)
+{
+    // The body receives in full the impulse the spheres received in the last exchange's sub-steps, sum x dt,
+    // spread over this exchange of steps x dt: the sub-steps' mean force when the two exchanges are equally
+    // long, as they are except where the runaway guard starts or ends a hold. The first step holds the
+    // initial state's force. (The per-body loops touch each body's own data and run on the DEM's threads.)
     const double scale = samples_ == 0 ? 0.0 : 1.0 / (initial_reaction_ ? samples_ : steps);
     initial_reaction_ = false;
-    for_each_body(bodies_.size(), threads, [&](std::size_t k) {
+    for_each_body(bodies_.size(), dem_.threads(), [&](std::size_t k) {
         CoupledBody& b = bodies_[k];
         b.applied_force_N = force_sum_[k] * scale;
         b.applied_torque_N_m = torque_sum_[k] * scale;
@@ -377,23 +386,28 @@ void CoupledWorld::exchange(int steps)
         torque_sum_[k] = Vec3{};
     });
     samples_ = 0;
-    const double interval = dem_.step_s() * steps;
-    if (before_rigid_step_) before_rigid_step_(dem_.time_s() + interval);
-    rigid_.set_step_s(interval);
-    auto mark = std::chrono::steady_clock::now();
-    rigid_.step();
-    auto now = std::chrono::steady_clock::now();
-    rigid_seconds_ += std::chrono::duration<double>(now - mark).count();
-    for_each_body(bodies_.size(), threads, [&](std::size_t k) {
+    return dem_.step_s() * steps;
+}
+
+void CoupledWorld::step_rigid(double step_s)
+{
+    const auto mark = std::chrono::steady_clock::now();
+    rigid_.step(step_s);
+    rigid_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - mark).count();
+}
+
+void CoupledWorld::run_dem(int steps, double interval_s)
+{
+    // the surfaces' poses at both ends of Bullet's step
+    for_each_body(bodies_.size(), dem_.threads(), [&](std::size_t k) {
         after_[k] = pose_of(bodies_[k]);
         spin_rad_[k] = rotation_vector(after_[k].rotation * before_[k].rotation.transposed());
     });
-
-    // 2. and 3. the DEM sub-steps, the surfaces moving from the old poses to the new ones
+    // the DEM sub-steps, the surfaces moving from the old poses to the new ones, the reactions summed
     dem::World::StepHooks hooks;
     hooks.before_forces = [&](std::uint64_t s) {
         const auto start = std::chrono::steady_clock::now();
-        move_surfaces(static_cast<double>(s + 1) / steps, interval);
+        move_surfaces(static_cast<double>(s + 1) / steps, interval_s);
         surface_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     hooks.after_forces = [&](std::uint64_t) {
@@ -410,24 +424,25 @@ void CoupledWorld::exchange(int steps)
     dem_.run_steps(static_cast<std::uint64_t>(steps), hooks);
 }
 
-void CoupledWorld::step()
+void CoupledWorld::end_step()
 {
-    if (checked_bodies_ != bodies_.size()) {
-        check_pairs();
-        checked_bodies_ = bodies_.size();
-    }
-    if (!started_) start();
-
-    // one exchange of all the coupling step's DEM steps, or, while the runaway guard holds, one per DEM step
     const int n = settings_.substeps;
-    if (n > 1 && hold_steps_ > 0) {
-        for (int s = 0; s < n; ++s) exchange(1);
+    if (held_) {
         --hold_steps_;
         ++guarded_steps_;
-    } else {
-        exchange(n);
     }
     if (n > 1 && settings_.runaway_guard) watch_for_runaways();
+}
+
+void CoupledWorld::step()
+{
+    const int steps = begin_step();
+    for (int e = 0; e < settings_.substeps / steps; ++e) {
+        const double interval = send_reactions(steps);
+        step_rigid(interval);
+        run_dem(steps, interval);
+    }
+    end_step();
 }
 
 void CoupledWorld::run_steps(std::uint64_t n)

@@ -92,13 +92,32 @@ public:
                            dem::MaterialIndex dem_material, const Vec3& position_m, const Mat3& rotation = Mat3::identity(),
                            const Vec3& velocity_m_per_s = {}, const Vec3& angular_velocity_rad_per_s = {});
 
-    /// Called before each Bullet step with the time it steps to (a coupling step has several Bullet steps when
-    /// the guard splits it): the place to set kinematic bodies' poses from their prescribed motion.
-    void set_before_rigid_step(std::function<void(double t_end_s)> hook) { before_rigid_step_ = std::move(hook); }
-
     /// One coupling step (substeps DEM steps). Throws SimulationError with a diagnosis if either side blows up.
+    /// It is, in order:
+    ///     const int steps = begin_step();
+    ///     for each of the substeps / steps exchanges:
+    ///         const double interval = send_reactions(steps);  // 1. the reactions to the bodies
+    ///         step_rigid(interval);                           //    Bullet's step
+    ///         run_dem(steps, interval);                       // 2., 3. the DEM sub-steps
+    ///     end_step();
+    /// A caller that must act between the parts (place kinematic bodies before Bullet's step: CoSimulation)
+    /// calls them itself in this order.
     void step();
     void run_steps(std::uint64_t n);
+
+    /// Starts a coupling step; returns the DEM steps of each of its exchanges: substeps, or 1 while the runaway
+    /// guard holds (then the step is substeps exchanges of one DEM step).
+    int begin_step();
+    /// Gives each dynamic body the spheres' mean reaction over the last exchange and records the bodies' poses
+    /// before Bullet's step. Returns the length of that step: `steps` DEM steps.
+    double send_reactions(int steps);
+    /// Bullet's step of step_s (timed in rigid_seconds()).
+    void step_rigid(double step_s);
+    /// The DEM's `steps` sub-steps over Bullet's step of interval_s, the coupled surfaces moving from the poses
+    /// before it to those after it, the spheres' reactions summed for the next exchange.
+    void run_dem(int steps, double interval_s);
+    /// Ends the coupling step: the runaway guard's count and watch.
+    void end_step();
 
     double time_s() const { return dem_.time_s(); }
     double dem_step_s() const { return dem_.step_s(); }
@@ -153,8 +172,6 @@ private:
     void start();
     void check_pairs() const;
     void move_surfaces(double fraction, double interval_s);
-    /// One Bullet step and `steps` DEM steps (steps 1 and 2 of the class comment).
-    void exchange(int steps);
     /// The runaway guard's watch over the rocks at the end of a coupling step.
     void watch_for_runaways();
 
@@ -176,13 +193,13 @@ private:
         double growth = 1.0;
     };
     std::vector<Watch> watch_;
-    std::function<void(double)> before_rigid_step_;
     std::int32_t hold_steps_ = 0;  ///< coupling steps still to run as exchanges of one DEM step
     std::uint64_t guarded_steps_ = 0, runaways_caught_ = 0;
     int samples_ = 0;
     bool initial_reaction_ = false;  ///< the sums hold the initial state's force, not an exchange's sub-steps
     double rigid_seconds_ = 0.0, surface_seconds_ = 0.0;
     bool started_ = false;
+    bool held_ = false;  ///< the step in progress is split by the runaway guard
     std::size_t checked_bodies_ = 0;
 };
 

@@ -41,7 +41,6 @@ Vec3 point_force_on_a(const btManifoldPoint& p, double dt)
 
 RigidWorld::RigidWorld(RigidSettings settings)
 {
-    require_positive(settings.step_s, "step_s", "rigid settings");
     if (settings.solver_iterations < 1 || settings.solver_iterations > 1000)
         throw InputError(concat("rigid settings: solver_iterations is ", settings.solver_iterations, "; expected 1..1000"));
     require_non_negative(settings.split_impulse_threshold_m, "split_impulse_threshold_m", "rigid settings");
@@ -240,7 +239,8 @@ BodyState RigidWorld::state(BodyId id) const
     const Impl::Body& body = impl_->body(id, "state");
     if (body.multibody) {  // a link: pose from its collider, velocity by finite difference over the last step
         const btTransform& t = body.link_collider->getWorldTransform();
-        const double dt = impl_->settings.step_s;
+        const double dt = impl_->step_s;
+        if (dt == 0.0) return {from_bt(t.getOrigin()), from_bt(t.getBasis()), {}, {}};  // before the first step
         const btVector3 v = (t.getOrigin() - body.previous_pose.getOrigin()) / dt;
         btVector3 axis;
         btScalar angle;
@@ -312,9 +312,11 @@ bool RigidWorld::is_dynamic(BodyId id) const
     return b.multibody != nullptr || b.is_rock();
 }
 
-void RigidWorld::step()
+void RigidWorld::step(double step_s)
 {
-    const double dt = impl_->settings.step_s;
+    require_positive(step_s, "step_s", "rigid world step");
+    impl_->step_s = step_s;
+    const double dt = step_s;
     if (impl_->checked_bodies != impl_->bodies.size()) impl_->check_pairs();
     impl_->velocity_before.resize(impl_->bodies.size());
     impl_->spin_before.resize(impl_->bodies.size());
@@ -387,7 +389,7 @@ void RigidWorld::write_state(StateWriter& out) const
     out.value<std::uint64_t>(w.bodies.size());
     out.value(w.time_s);
     out.value(w.step_count);
-    out.value(w.settings.step_s);
+    out.value(w.step_s);
     for (const auto& b : w.bodies) {
         out.text(b->name);
         if (b->body) {
@@ -414,7 +416,8 @@ void RigidWorld::read_state(StateReader& in)
         in.fail(concat("the checkpoint has ", n, " rigid bodies, the world built from its scenario ", w.bodies.size()));
     w.time_s = in.value<double>();
     w.step_count = in.value<std::uint64_t>();
-    w.settings.step_s = in.value<double>();
+    w.step_s = in.value<double>();
+    if (!(w.step_s >= 0.0) || !std::isfinite(w.step_s)) in.fail(concat("a last rigid step of ", w.step_s, " s"));
     for (auto& b : w.bodies) {
         const std::string name = in.text();
         if (name != b->name) in.fail(concat("rigid body '", name, "' where the world has '", b->name, "'"));
@@ -442,15 +445,11 @@ void RigidWorld::read_state(StateReader& in)
     for (const Vec3& x : spin) w.spin_before.push_back(to_bt(x));
     const bool shovel = in.value<std::uint8_t>() != 0;
     if (shovel != (w.shovel != nullptr)) in.fail("the checkpoint and the world differ in having a rope shovel");
-    if (shovel) read_shovel_state(*w.shovel, in);
+    if (shovel) read_shovel_state(*w.shovel, in, w.step_s);
     if (w.contact_force.size() != w.bodies.size()) in.fail("rigid contact forces of another number of bodies");
 }
 
-void RigidWorld::set_step_s(double step_s)
-{
-    require_positive(step_s, "step_s", "rigid world");
-    impl_->settings.step_s = step_s;
-}
+double RigidWorld::last_step_s() const { return impl_->step_s; }
 const RigidSettings& RigidWorld::settings() const { return impl_->settings; }
 
 Vec3 RigidWorld::contact_force_N(BodyId id) const
@@ -462,8 +461,9 @@ Vec3 RigidWorld::contact_force_N(BodyId id) const
 std::vector<RigidWorld::PointForce> RigidWorld::contact_point_forces(BodyId id) const
 {
     impl_->body(id, "contact_point_forces");
-    const double dt = impl_->settings.step_s;
+    const double dt = impl_->step_s;
     std::vector<PointForce> out;
+    if (dt == 0.0) return out;  // no step, no contact impulses
     btDispatcher& d = impl_->dispatcher;
     for (int q = 0; q < d.getNumManifolds(); ++q) {
         const btPersistentManifold* m = d.getManifoldByIndexInternal(q);
@@ -554,8 +554,9 @@ std::vector<ContactRecord> RigidWorld::surface_contacts(BodyId surface, std::int
         part.located_mesh = wear_mesh;
     }
     const btTransform to_part = (part.object()->getWorldTransform() * part.part_in_object).inverse();
-    const double dt = impl_->settings.step_s;
+    const double dt = impl_->step_s;
     std::vector<ContactRecord> out;
+    if (dt == 0.0) return out;
     std::vector<int> now_touching;
     const bool continues = part.touching_step + 1 == impl_->step_count;  // reported for the step before too
     btDispatcher& d = impl_->dispatcher;

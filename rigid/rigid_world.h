@@ -21,7 +21,6 @@ using BodyId = int;
 /// How the rigid world steps. The defaults are the ones the verification tests justify (docs/rigid.md).
 struct RigidSettings {
     Vec3 gravity_m_per_s2{0.0, 0.0, -9.81};
-    double step_s = 1e-3;
     int solver_iterations = 10;
     /// Overlap that Bullet corrects inside the contact impulse; deeper overlaps are pushed apart by a
     /// separate position correction that adds no momentum. 0: contact impulses carry physical loads only.
@@ -131,12 +130,13 @@ public:
     void door_pose(Mat3& rotation, Vec3& origin_m) const;
 
     // ---- stepping
-    /// Exactly one Bullet step of settings().step_s: no sub-steps, no interpolation.
-    void step();
+    /// Exactly one Bullet step of step_s: no sub-steps, no interpolation. Each step may have its own length.
+    void step(double step_s);
     double time_s() const;
+    /// Length of the last step, s (0 before the first): what the shovel's forces and the links' velocities
+    /// are differences over.
+    double last_step_s() const;
     const RigidSettings& settings() const;
-    /// Changes the step for the steps that follow (for example: settle a pile at a coarse step).
-    void set_step_s(double step_s);
 
     // ---- checkpoints
     /// Writes the moving state: time, every rock's and kinematic part's pose and velocities, the shovel's

@@ -236,7 +236,6 @@ struct ShovelState {
     btVector3 base_origin;       // where the machine stands before it propels
     btVector3 forward;           // unit, its heading on the ground
     bool propels = false;        // the motion moves the machine (else its base never changes)
-    double step_s = 0.0;
 };
 
 namespace {
@@ -245,9 +244,13 @@ namespace {
 void place_base(ShovelState& s, double t, double dt)
 {
     btMultiBody& mb = *s.body;
-    const double p = s.motion.at(t).propel_m, p_next = s.motion.at(t + dt).propel_m;
+    // the propel speed over the step ahead (dt of the step to come or just done; before the first step, over
+    // kBaseLookAhead_s: the speed is set again before every step, and nothing reads it before)
+    constexpr double kBaseLookAhead_s = 1e-3;
+    const double ahead = dt > 0.0 ? dt : kBaseLookAhead_s;
+    const double p = s.motion.at(t).propel_m, p_next = s.motion.at(t + ahead).propel_m;
     mb.setBasePos(s.base_origin + s.forward * p);
-    mb.setBaseVel(s.forward * ((p_next - p) / dt));
+    mb.setBaseVel(s.forward * ((p_next - p) / ahead));
     btAlignedObjectArray<btQuaternion> scratch_q;
     btAlignedObjectArray<btVector3> scratch_m;
     mb.forwardKinematics(scratch_q, scratch_m);
@@ -393,10 +396,10 @@ RigidWorld::ShovelParts RigidWorld::add_rope_shovel(const meshes::Dipper& dipper
     impl_->world.addMultiBody(&mb);
 
     // ---- drives
-    const double dt = impl_->settings.step_s;
-    s->swing_motor = std::make_unique<btMultiBodyJointMotor>(&mb, 0, 0.0, 1e10 * dt);
-    s->crowd_motor = std::make_unique<btMultiBodyJointMotor>(&mb, 2, 0.0, g.max_crowd_force_N * dt);
-    s->door_motor = std::make_unique<btMultiBodyJointMotor>(&mb, 3, 0.0, 1e9 * dt);
+    // their largest impulses are force x step, set before each step (shovel_before_step)
+    s->swing_motor = std::make_unique<btMultiBodyJointMotor>(&mb, 0, 0.0, 0.0);
+    s->crowd_motor = std::make_unique<btMultiBodyJointMotor>(&mb, 2, 0.0, 0.0);
+    s->door_motor = std::make_unique<btMultiBodyJointMotor>(&mb, 3, 0.0, 0.0);
     for (auto* m : {s->swing_motor.get(), s->crowd_motor.get(), s->door_motor.get()}) impl_->world.addMultiBodyConstraint(m);
 
     // ---- initial pose: the handle angle at which the ropes are just taut at the first hoist length
@@ -421,8 +424,7 @@ RigidWorld::ShovelParts RigidWorld::add_rope_shovel(const meshes::Dipper& dipper
     mb.setJointPos(2, m0.crowd_extension_m);
     mb.setJointPos(3, m0.door_deg * kDeg);
     for (const MotionSample& m : s->motion.samples()) s->propels = s->propels || m.propel_m != 0.0;
-    s->step_s = impl_->settings.step_s;
-    place_base(*s, impl_->time_s, s->step_s);
+    place_base(*s, impl_->time_s, impl_->step_s);
     for (auto& b : impl_->bodies)
         if (b->multibody) b->previous_pose = b->link_collider->getWorldTransform();
 
@@ -437,7 +439,7 @@ void shovel_before_step(RigidWorld::Impl& w, double t_next)
 {
     ShovelState& s = *w.shovel;
     btMultiBody& mb = *s.body;
-    const double dt = w.settings.step_s;
+    const double dt = w.step_s;
     if (s.propels) place_base(s, t_next - dt, dt);
     // drives: reach the curves' positions at the end of the step
     const MotionSample target = s.motion.at(t_next);
@@ -504,7 +506,7 @@ void read_pose(ShovelState& s)
 void shovel_after_step(RigidWorld::Impl& w)
 {
     ShovelState& s = *w.shovel;
-    const double dt = w.settings.step_s;
+    const double dt = w.step_s;
     ShovelReading& r = s.reading;
     r.time_s = w.time_s;
     r.crowd_force_N = s.crowd_motor->getAppliedImpulse(0) / dt;
@@ -545,7 +547,7 @@ void write_shovel_state(const ShovelState& s, StateWriter& out)
     out.value(s.reading);
 }
 
-void read_shovel_state(ShovelState& s, StateReader& in)
+void read_shovel_state(ShovelState& s, StateReader& in, double last_step_s)
 {
     in.tag("rope shovel");
     btMultiBody& mb = *s.body;
@@ -567,7 +569,7 @@ void read_shovel_state(ShovelState& s, StateReader& in)
     s.window.clear();
     for (std::uint64_t k = 0; k < n; ++k) s.window.push_back(in.value<ShovelState::Sample>());
     s.reading = in.value<ShovelReading>();
-    place_base(s, s.reading.time_s, s.step_s);
+    place_base(s, s.reading.time_s, last_step_s);
 }
 
 const ShovelReading& RigidWorld::shovel_reading() const

@@ -1,7 +1,6 @@
 #include "scenario/run_limits.h"
 
 #include "core/errors.h"
-#include "scenario/rigid_scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -86,10 +85,12 @@ void require_spheres_at_start(const Scenario& s, const dem::World& world)
 
 void check_scenario(const Scenario& s)
 {
-    const auto world = build_world(s);  // mesh files are read and checked too
+    std::unique_ptr<dem::World> own = build_world(s);  // mesh files are read and checked too
+    dem::World* const world = own.get();
     check_pairs(s);
     // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
-    if (s.uses_coupling()) RigidScene scene(s, *world);
+    std::unique_ptr<coupling::CoSimulation> sim;
+    if (s.uses_coupling()) sim = build_co_simulation(s, std::move(own));
     // what the run places at t = 0 before its first step, where the step depends on it: the pours due at 0
     // when no fill or pile brings spheres (the same seeds as the run)
     const bool fills_bring_spheres = std::any_of(s.fills.begin(), s.fills.end(), [](const FillSpec& f) {

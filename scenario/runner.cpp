@@ -5,7 +5,6 @@
 #include "core/state_io.h"
 #include "dem/output.h"
 #include "coupling/mixed_bed.h"
-#include "scenario/rigid_scene.h"
 #include "wear/calibration.h"
 #include "wear/wear_output.h"
 
@@ -119,21 +118,20 @@ public:
             copy << scenario_.text;
             finish_writing(copy, dir_ + "/scenario.yaml");
         }
-        world_ = build_world(scenario_);
-        if (scenario_.uses_coupling()) rigid_ = std::make_unique<RigidScene>(scenario_, *world_);
+        build(build_world(scenario_));
         if (!scenario_.pile.empty()) {  // errors name file and line
-            const RigidScene& scene = *rigid_;
-            pile_ = coupling::load_state(rigid_->coupled(), scenario_.pile,
-                                         [&scene](const Vec3& c, double r) { return scene.clear_of_machine(c, r); });
+            const coupling::CoSimulation& sim = *sim_;
+            pile_ = coupling::load_state(sim_->coupled(), scenario_.pile,
+                                         [&sim](const Vec3& c, double r) { return sim.clear_of_machine(c, r); });
             if (options_.progress && (pile_.spheres_left_out > 0 || pile_.rocks_left_out > 0))
                 std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
                              scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);
         }
         require_run_fits(scenario_, *world_);  // before the fills claim the memory
         build_particles(scenario_, *world_);
-        if (rigid_) {
-            rigid_->fill_mixed(scenario_);
-            rigid_->add_wear(scenario_);
+        if (sim_) {
+            fill_rocks(scenario_, *sim_);
+            add_wear(scenario_, *sim_);
         }
         pourers_ = make_pourers(scenario_, *world_);
         for (dem::Pourer& p : pourers_) p.update(*world_);
@@ -151,16 +149,15 @@ public:
     /// Continues from a checkpoint written by checkpoint().
     void start_from(StateReader& in)
     {
-        world_ = build_world(scenario_);
-        if (scenario_.uses_coupling()) {
+        build(build_world(scenario_));
+        if (sim_) {
             // the bodies in the order of the run: walls and shovel, the rocks, then the wear surfaces
-            rigid_ = std::make_unique<RigidScene>(scenario_, *world_);
-            rigid_->coupled().read_rocks(in);
-            rigid_->add_wear(scenario_);
+            sim_->coupled().read_rocks(in);
+            add_wear(scenario_, *sim_);
         }
         pourers_ = make_pourers(scenario_, *world_);
         world_->read_state(in);
-        if (rigid_) rigid_->read_state(in);
+        if (sim_) sim_->read_state(in);
         in.tag("pours");
         for (dem::Pourer& p : pourers_) p.read_state(in);
         in.tag("outputs");
@@ -173,7 +170,7 @@ public:
         pile_ = in.value<coupling::LoadedState>();
         const auto csv_bytes = in.value<std::uint64_t>();
         walls_ = all_walls();
-        const std::size_t series = 1 + walls_.size() + (rigid_ ? 1 + rigid_->wear().size() : 0);
+        const std::size_t series = 1 + walls_.size() + (sim_ ? 1 + sim_->wear().size() : 0);
         std::vector<std::vector<std::pair<double, std::string>>> entries(series);
         for (auto& e : entries) {
             const auto n = in.value<std::uint64_t>();
@@ -192,7 +189,7 @@ public:
             if (w) w->restore(entries[k]);
             ++k;
         }
-        if (rigid_) {
+        if (sim_) {
             if (rocks_pvd_) rocks_pvd_->restore(entries[k]);
             ++k;
             for (const auto& w : wear_pvd_) w->restore(entries[k++]);
@@ -214,8 +211,8 @@ public:
         // a shovel run may end after a number of passes: 1 s after the last one's door opened
         const std::size_t passes = scenario_.shovel ? static_cast<std::size_t>(scenario_.shovel->passes) : 0;
         const auto end_after_passes = [&] {
-            if (passes > 0 && rigid_->passes().size() >= passes)
-                end_s = std::min(end_s, rigid_->passes()[passes - 1].dump_s + 1.0);
+            if (passes > 0 && sim_->passes().size() >= passes)
+                end_s = std::min(end_s, sim_->passes()[passes - 1].dump_s + 1.0);
         };
         end_after_passes();  // a resumed run may have done its passes already
         if (reached(end_s)) {
@@ -240,8 +237,8 @@ public:
             while (!reached(end_s)) {
                 remove_walls_due();
                 const std::uint64_t before = world_->step_count();
-                if (rigid_) {
-                    rigid_->step();
+                if (sim_) {
+                    sim_->step();
                     end_after_passes();
                 } else {
                     world_->step();
@@ -282,31 +279,48 @@ public:
                 if (scenario_.output.csv_interval_s > 0.0 && last_row_step_ != world_->step_count()) write_row();
                 checkpoint();
                 if (!scenario_.output.pile_file.empty())
-                    coupling::save_state(rigid_->coupled(), dir_ + "/" + scenario_.output.pile_file, scenario_.output.pile_cut_above_m);
+                    coupling::save_state(sim_->coupled(), dir_ + "/" + scenario_.output.pile_file, scenario_.output.pile_cut_above_m);
             }
         } catch (const SimulationError& e) {
             result.status = RunStatus::diverged;
             result.message = e.what();
         }
         if (options_.progress) progress(start, first_step, terminal, true);
-        if (rigid_) {
+        if (sim_) {
             write_wear_maps();
-            compare_measured_wear();  // the points were checked against the surfaces before the run
+            try {
+                compare_measured_wear();  // the points were checked against the surfaces before the run
+            } catch (const InputError& e) {
+                // a run stopped before it wore the measured points keeps its summary (resume it to the end); a
+                // finished one that did not wear them is the user's error, reported after the summary is written
+                if (result.status == RunStatus::completed) calibration_error_ = e.what();
+                else result.message = concat(result.message, "; no wear calibration yet: ", e.what());
+                calibrations_.resize(sim_->wear().size());
+            }
             write_wear_sections();
         }
         result.time_s = world_->time_s();
         result.steps = world_->step_count();
         write_summary(result, start);
+        if (!calibration_error_.empty()) throw InputError(calibration_error_);
         return result;
     }
 
 private:
     static constexpr std::uint64_t kPourEvery = 20;  ///< steps between pour insertions
 
+    /// Takes the scenario's DEM world; a run with rocks, the shovel, wear or a pile hands it to a co-simulation.
+    void build(std::unique_ptr<dem::World> world)
+    {
+        world_ = world.get();
+        if (scenario_.uses_coupling()) sim_ = build_co_simulation(scenario_, std::move(world));
+        else own_world_ = std::move(world);
+    }
+
     /// The walls that outputs list: all of them, less the hulls of rocks.
     std::vector<int> all_walls() const
     {
-        if (rigid_) return rigid_->listed_walls();
+        if (sim_) return sim_->listed_walls();
         std::vector<int> walls;
         for (std::size_t w = 0; w < world_->wall_count(); ++w) walls.push_back(static_cast<int>(w));
         return walls;
@@ -323,10 +337,10 @@ private:
             else
                 wall_pvd_.push_back(nullptr);
         }
-        if (rigid_) {
-            if (!rigid_->coupled().rocks().empty()) rocks_pvd_ = std::make_unique<dem::PvdCollection>(dir_ + "/rocks.pvd");
-            for (const SceneWear& w : rigid_->wear())
-                wear_pvd_.push_back(std::make_unique<dem::PvdCollection>(dir_ + "/wear_" + w.spec.part + ".pvd"));
+        if (sim_) {
+            if (!sim_->coupled().rocks().empty()) rocks_pvd_ = std::make_unique<dem::PvdCollection>(dir_ + "/rocks.pvd");
+            for (const coupling::WearPart& w : sim_->wear())
+                wear_pvd_.push_back(std::make_unique<dem::PvdCollection>(dir_ + "/wear_" + w.part + ".pvd"));
         }
         const std::string csv_path = dir_ + "/probes.csv";
         if (resuming) {
@@ -346,12 +360,12 @@ private:
             for (const char* axis : {"x", "y", "z"}) csv_ << ",force_" << world_->wall_name(w) << "_" << axis << "_N";
         for (const RegionProbe& r : scenario_.regions) csv_ << "," << r.name << "_mass_kg";
         if (scenario_.repose) csv_ << ",repose_angle_deg";
-        if (rigid_) {
+        if (sim_) {
             csv_ << ",rocks,rock_kinetic_energy_J,rock_contacts";
-            if (rigid_->has_shovel())
+            if (sim_->has_shovel())
                 csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,interface_force_N,interface_force_without_lip_N,swing_deg,door_deg,"
                         "handle_angle_deg,crowd_extension_m,tooth_tip_x_m,tooth_tip_y_m,tooth_tip_z_m";
-            for (const SceneWear& w : rigid_->wear()) csv_ << ",wear_" << w.spec.part << "_m3";
+            for (const coupling::WearPart& w : sim_->wear()) csv_ << ",wear_" << w.part << "_m3";
         }
         csv_ << ",wall_s_per_step,wall_clock_s\n";
         finish_writing(csv_, csv_path);
@@ -375,7 +389,7 @@ private:
     {
         try {
             return dem::fit_repose_angle(world_->particles(), scenario_.repose->window, scenario_.repose->where,
-                                         rigid_ ? rigid_->rock_surface_points() : std::vector<Vec3>{});
+                                         sim_ ? sim_->rock_surface_points() : std::vector<Vec3>{});
         } catch (const InputError&) {
             return std::nullopt;
         }
@@ -399,18 +413,18 @@ private:
         }
         for (const RegionProbe& r : scenario_.regions) csv_ << ',' << region_mass_kg(r);
         if (scenario_.repose) csv_ << ',' << repose_angle_deg();
-        if (rigid_) {
-            const rigid::RigidWorld& rw = rigid_->rigid();
-            csv_ << ',' << rigid_->coupled().rocks().size() << ',' << rw.kinetic_energy_J() << ',' << rw.contact_point_count();
-            if (rigid_->has_shovel()) {
-                const BucketContents b = rigid_->bucket();
-                const rigid::ShovelReading& r = rigid_->reading();
+        if (sim_) {
+            const rigid::RigidWorld& rw = sim_->rigid();
+            csv_ << ',' << sim_->coupled().rocks().size() << ',' << rw.kinetic_energy_J() << ',' << rw.contact_point_count();
+            if (sim_->has_shovel()) {
+                const coupling::BucketContents b = sim_->bucket();
+                const rigid::ShovelReading& r = sim_->reading();
                 csv_ << ',' << b.mass_kg << ',' << b.fill_factor << ',' << r.crowd_force_filtered_N << ',' << r.hoist_force_filtered_N << ','
-                     << r.dig_force_filtered_N << ',' << norm(rigid_->interface_force_N()) << ','
-                     << norm(rigid_->interface_force_N() - rigid_->lip_force_N()) << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
+                     << r.dig_force_filtered_N << ',' << norm(sim_->interface_force_N()) << ','
+                     << norm(sim_->interface_force_N() - sim_->lip_force_N()) << ',' << r.swing_deg << ',' << r.door_deg << ',' << r.handle_angle_deg << ','
                      << r.crowd_extension_m << ',' << r.tooth_tip_m.x << ',' << r.tooth_tip_m.y << ',' << r.tooth_tip_m.z;
             }
-            for (const SceneWear& sw : rigid_->wear()) csv_ << ',' << sw.surface->total_volume_m3();
+            for (const coupling::WearPart& part : sim_->wear()) csv_ << ',' << part.surface->total_volume_m3();
         }
         const double now = wall_seconds_now();
         const std::uint64_t steps = w.step_count() - row_step_;
@@ -435,17 +449,18 @@ private:
         }
         if (rocks_pvd_) {
             const std::string rock_file = numbered("rocks", snapshot_index_);
-            rigid_->write_rocks_vtp(dir_ + "/" + rock_file);
+            sim_->write_rocks_vtp(dir_ + "/" + rock_file);
             rocks_pvd_->add(world_->time_s(), rock_file);
         }
-        if (rigid_)
-            for (std::size_t k = 0; k < rigid_->wear().size(); ++k) {
-                const SceneWear& sw = rigid_->wear()[k];
-                const std::string wear_file = numbered("wear_" + sw.spec.part, snapshot_index_);
+        if (sim_)
+            for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
+                const coupling::WearPart& w = sim_->wear()[k];
+                const std::string wear_file = numbered("wear_" + w.part, snapshot_index_);
                 Mat3 r;
                 Vec3 o;
-                rigid_->wear_pose(sw, r, o);
-                wear::write_wear_vtp(*sw.surface, dir_ + "/" + wear_file, rigid_->tonnage_t(sw), sw.spec.smoothing_iterations, r, o);
+                sim_->wear_pose(w, r, o);
+                wear::write_wear_vtp(*w.surface, dir_ + "/" + wear_file, wear_tonnage_t(scenario_, *sim_, k),
+                                     scenario_.wear[k].smoothing_iterations, r, o);
                 wear_pvd_[k]->add(world_->time_s(), wear_file);
             }
         ++snapshot_index_;
@@ -460,14 +475,16 @@ private:
     /// from inside, a floor), once material has passed; a part with no face towards +z gets none.
     void write_wear_maps()
     {
-        for (const SceneWear& sw : rigid_->wear()) {
-            if (!(rigid_->tonnage_t(sw) > 0.0)) continue;
+        for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
+            const coupling::WearPart& w = sim_->wear()[k];
+            const double tonnage = wear_tonnage_t(scenario_, *sim_, k);
+            if (!(tonnage > 0.0)) continue;
             wear::MapView view;
             // the dipper's bottom, seen from inside: its top plate's outside lies above it
-            if (sw.spec.part == "dipper") view.max_along_view_m = rigid_->dipper().parameters.height_m / 2.0;
+            if (w.part == "dipper") view.max_along_view_m = sim_->dipper().parameters.height_m / 2.0;
             try {
-                wear::write_wear_map_png(*sw.surface, dir_ + "/wear_" + sw.spec.part + "_map.png", rigid_->tonnage_t(sw),
-                                         sw.spec.smoothing_iterations, view);
+                wear::write_wear_map_png(*w.surface, dir_ + "/wear_" + w.part + "_map.png", tonnage, scenario_.wear[k].smoothing_iterations,
+                                         view);
             } catch (const InputError&) {
                 // no triangle of the part faces +z: no map
             }
@@ -479,15 +496,17 @@ private:
     void compare_measured_wear()
     {
         calibrations_.clear();
-        for (const SceneWear& sw : rigid_->wear()) {
-            if (sw.spec.measured_file.empty() || !(rigid_->tonnage_t(sw) > 0.0)) {
+        for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
+            const WearSpec& spec = scenario_.wear[k];
+            const double tonnage = wear_tonnage_t(scenario_, *sim_, k);
+            if (spec.measured_file.empty() || !(tonnage > 0.0)) {
                 calibrations_.emplace_back();
                 continue;
             }
-            const auto points = wear::read_measured_points(sw.spec.measured_file);
-            const wear::CalibrationResult c = wear::calibrate(*sw.surface, rigid_->tonnage_t(sw), sw.spec.smoothing_iterations, points,
+            const auto points = wear::read_measured_points(spec.measured_file);
+            const wear::CalibrationResult c = wear::calibrate(*sim_->wear()[k].surface, tonnage, spec.smoothing_iterations, points,
                                                               wear::MeasurementUncertainty{}, kMeasuredPointTolerance_m);
-            wear::write_points_csv(dir_ + "/wear_" + sw.spec.part + "_points.csv", c.before);
+            wear::write_points_csv(dir_ + "/wear_" + spec.part + "_points.csv", c.before);
             calibrations_.push_back(c);
         }
     }
@@ -497,19 +516,20 @@ private:
     void write_wear_sections()
     {
         sections_.clear();
-        for (std::size_t k = 0; k < rigid_->wear().size(); ++k) {
-            const SceneWear& sw = rigid_->wear()[k];
+        for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
+            const WearSpec& spec = scenario_.wear[k];
+            const double tonnage = wear_tonnage_t(scenario_, *sim_, k);
             sections_.emplace_back();
-            if (sw.spec.sections.empty() || !(rigid_->tonnage_t(sw) > 0.0)) continue;
-            const wear::RateMap map(*sw.surface, rigid_->tonnage_t(sw), sw.spec.smoothing_iterations);
+            if (spec.sections.empty() || !(tonnage > 0.0)) continue;
+            const wear::RateMap map(*sim_->wear()[k].surface, tonnage, spec.smoothing_iterations);
             const std::vector<wear::PointComparison> none;
             const auto& measured = k < calibrations_.size() && calibrations_[k].scale > 0.0 ? calibrations_[k].before : none;
-            for (const WearSectionSpec& section : sw.spec.sections) {
+            for (const WearSectionSpec& section : spec.sections) {
                 SectionResult r;
                 r.name = section.name;
                 r.profile = wear::sample_section(map, section.points_m, section.spacing_m, kMeasuredPointTolerance_m, section.name);
                 r.measured = wear::points_on_section(section.points_m, measured, kMeasuredPointTolerance_m);
-                wear::write_section_csv(dir_ + "/wear_" + sw.spec.part + "_section_" + section.name + ".csv", r.profile, r.measured);
+                wear::write_section_csv(dir_ + "/wear_" + spec.part + "_section_" + section.name + ".csv", r.profile, r.measured);
                 sections_.back().push_back(std::move(r));
             }
         }
@@ -523,9 +543,9 @@ private:
         out.text(scenario_.source);
         out.text(scenario_.base_dir);
         out.value<std::int32_t>(world_->threads());
-        if (rigid_) rigid_->coupled().write_rocks(out);
+        if (sim_) sim_->coupled().write_rocks(out);
         world_->write_state(out);
-        if (rigid_) rigid_->write_state(out);
+        if (sim_) sim_->write_state(out);
         out.tag("pours");
         for (const dem::Pourer& p : pourers_) p.write_state(out);
         out.tag("outputs");
@@ -548,7 +568,7 @@ private:
         };
         write_entries(particles_pvd_.get());
         for (const auto& w : wall_pvd_) write_entries(w.get());
-        if (rigid_) {
+        if (sim_) {
             write_entries(rocks_pvd_.get());
             for (const auto& w : wear_pvd_) write_entries(w.get());
         }
@@ -674,23 +694,23 @@ private:
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
             << "  \"state_hash\": \"" << hash << "\"";
-        if (rigid_) write_rigid_summary(out);
+        if (sim_) write_rigid_summary(out);
         out << "\n}\n";
         finish_writing(out, dir_ + "/summary.json");
     }
 
     void write_rigid_summary(std::ostream& out) const
     {
-        const RigidScene& r = *rigid_;
-        out << ",\n  \"rocks\": " << r.coupled().rocks().size() << ",\n  \"rock_kinetic_energy_J\": " << json_number(r.rock_kinetic_energy_J());
+        const coupling::CoSimulation& r = *sim_;
+        out << ",\n  \"rocks\": " << r.coupled().rocks().size() << ",\n  \"rock_kinetic_energy_J\": " << json_number(r.rigid().kinetic_energy_J());
         out << ",\n  \"runaways_caught\": " << r.coupled().runaways_caught() << ",\n  \"guarded_coupling_steps\": "
             << r.coupled().guarded_steps();
         if (r.has_shovel()) {
-            const BucketContents b = r.bucket();
+            const coupling::BucketContents b = r.bucket();
             out << ",\n  \"bucket_mass_kg\": " << json_number(b.mass_kg) << ",\n  \"fill_factor\": " << json_number(b.fill_factor)
                 << ",\n  \"passes\": [";
             for (std::size_t k = 0; k < r.passes().size(); ++k) {
-                const PassRecord& p = r.passes()[k];
+                const coupling::PassRecord& p = r.passes()[k];
                 out << (k ? "," : "") << "\n    {\"pass\": " << k + 1 << ", \"start_s\": " << json_number(p.start_s)
                     << ", \"dig_start_s\": " << json_number(p.dig_start_s) << ", \"dig_end_s\": " << json_number(p.dig_end_s) << ", \"dump_s\": " << json_number(p.dump_s)
                     << ", \"mass_kg\": " << json_number(p.mass_kg) << ", \"fill_factor\": " << json_number(p.fill_factor)
@@ -705,12 +725,13 @@ private:
         }
         out << ",\n  \"tonnage_t\": " << json_number(r.tonnage_t()) << ",\n  \"wear\": {";
         for (std::size_t k = 0; k < r.wear().size(); ++k) {
-            const SceneWear& w = r.wear()[k];
-            const std::vector<double> depth = w.surface->node_depth_m(w.spec.smoothing_iterations);
+            const coupling::WearPart& w = r.wear()[k];
+            const WearSpec& spec = scenario_.wear[k];
+            const std::vector<double> depth = w.surface->node_depth_m(spec.smoothing_iterations);
             const double max_depth = depth.empty() ? 0.0 : *std::max_element(depth.begin(), depth.end());
-            out << (k ? ", " : "") << "\"" << json_escape(w.spec.part) << "\": {\"tonnage_t\": " << json_number(r.tonnage_t(w))
-                << ", \"law\": \"" << w.spec.law
-                << "\", \"constant\": " << json_number(w.spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
+            out << (k ? ", " : "") << "\"" << json_escape(spec.part) << "\": {\"tonnage_t\": " << json_number(wear_tonnage_t(scenario_, r, k))
+                << ", \"law\": \"" << spec.law
+                << "\", \"constant\": " << json_number(spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
                 << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth);
             const auto regions = r.wear_by_region(w);
             if (!regions.empty()) {
@@ -760,9 +781,11 @@ private:
     Scenario scenario_;
     std::string dir_;
     RunOptions options_;
-    std::unique_ptr<dem::World> world_;
-    std::unique_ptr<RigidScene> rigid_;  ///< rocks, shovel and wear; null for spheres and walls only
+    dem::World* world_ = nullptr;              ///< the run's DEM world: own_world_'s or sim_'s
+    std::unique_ptr<dem::World> own_world_;    ///< spheres and walls only
+    std::unique_ptr<coupling::CoSimulation> sim_;  ///< rocks, shovel and wear; null for spheres and walls only
     std::vector<wear::CalibrationResult> calibrations_;  ///< per wear surface, at the end (scale 0: none)
+    std::string calibration_error_;  ///< why a finished run's wear could not be calibrated (after the summary)
     struct SectionResult {
         std::string name;
         std::vector<wear::SectionSample> profile;

@@ -349,7 +349,7 @@ void read_materials(const MapReader& top, Scenario& s)
         if (names.size() != 2 || !rigid(names[0]) || !rigid(names[1]) || (names[0] != "rock" && names[1] != "rock"))
             p.fail("materials", concat("[", joined(names), "]"),
                    concat("[rock, X] with X one of the rigid materials ", joined(rigid_material_names())));
-        RockPairSpec pair{names[0], names[1], p.number("friction"), p.number("restitution")};
+        coupling::RockPair pair{names[0], names[1], p.number("friction"), p.number("restitution")};
         require_in_range(pair.friction, 0.0, 2.0, "friction", p.where("friction"));
         require_in_range(pair.restitution, 0.0, 1.0, "restitution", p.where("restitution"));
         s.rock_pairs.push_back(pair);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/vec3.h"
+#include "coupling/co_simulation.h"
 #include "dem/insertion.h"
 #include "dem/material.h"
 #include "dem/pile.h"
@@ -63,13 +64,7 @@ struct PourSpec : ParticleSource {
     double start_s = 0.0;  ///< nothing enters before this time
 };
 
-/// The materials of the rigid world (Bullet) a scenario can name: what rocks meet there. The DEM preset's
-/// surface materials that are not here (if any) touch spheres only.
-inline const std::vector<std::string>& rigid_material_names()
-{
-    static const std::vector<std::string> names{"rock", "ground", "bucket", "truck", "steel"};
-    return names;
-}
+using coupling::rigid_material_names;
 /// Names for messages: "a, b, c".
 inline std::string joined(const std::vector<std::string>& names)
 {
@@ -78,11 +73,6 @@ inline std::string joined(const std::vector<std::string>& names)
     return s;
 }
 
-/// Friction and restitution of rocks against rocks or a rigid wall material (Bullet), over the preset's.
-struct RockPairSpec {
-    std::string a, b;
-    double friction = 0.0, restitution = 0.0;
-};
 
 struct RegionProbe {
     std::string name;
@@ -149,7 +139,7 @@ struct Scenario {
     Vec3 gravity_m_per_s2{0.0, 0.0, -9.81};
     double duration_s = 0.0, step_s = 0.0;
     dem::MaterialTable materials;
-    std::vector<RockPairSpec> rock_pairs;  ///< applied in this order after the rigid preset
+    std::vector<coupling::RockPair> rock_pairs;  ///< applied in this order after the rigid preset
     std::vector<PlaneSpec> planes;
     std::vector<MeshSpec> meshes;
     std::string pile;  ///< a saved pile to start from (absolute path), or empty
@@ -163,7 +153,7 @@ struct Scenario {
     std::optional<ShovelSpec> shovel;
     std::vector<WearSpec> wear;
 
-    /// True if the run goes through the coupling (scenario/rigid_scene.h): it has rocks, the shovel, wear
+    /// True if the run goes through the co-simulation (coupling/co_simulation.h): it has rocks, the shovel, wear
     /// surfaces, or starts from or saves a pile.
     bool uses_coupling() const;
 };
@@ -181,9 +171,23 @@ std::unique_ptr<dem::World> build_world(const Scenario& scenario);
 /// with every wall's material; throws an InputError naming the pair and the scenario otherwise.
 void check_pairs(const Scenario& scenario);
 /// Places the particles of the fills without rocks (seeded by the scenario's seed and the fill's position
-/// in the list), clear of the walls. Fills with rocks are placed by RigidScene::fill_mixed.
+/// in the list), clear of the walls. Fills with rocks are placed by fill_rocks.
 void build_particles(const Scenario& scenario, dem::World& world);
 /// The pours, ready to run from t = 0 (each waits for its start_s).
 std::vector<dem::Pourer> make_pourers(const Scenario& scenario, const dem::World& world);
+
+/// How far a measured wear point or a wear section may lie from its part's surface, m.
+inline constexpr double kMeasuredPointTolerance_m = 0.1;
+
+/// The co-simulation of a scenario that uses_coupling(), around its DEM world (walls added, particles not
+/// yet): Bullet's walls and rock pairs, and the shovel. Errors name the scenario entry.
+std::unique_ptr<coupling::CoSimulation> build_co_simulation(const Scenario& scenario, std::unique_ptr<dem::World> dem);
+/// Places the fills that have rocks (the others go through build_particles), clear of the machine.
+void fill_rocks(const Scenario& scenario, coupling::CoSimulation& sim);
+/// Adds the wear surfaces, in the scenario's order, after the fills; their measured points and sections must
+/// lie on the part (kMeasuredPointTolerance_m).
+void add_wear(const Scenario& scenario, coupling::CoSimulation& sim);
+/// The tonnage wear surface k's rates divide by: its tonnage_t key, or the passes' tonnage.
+double wear_tonnage_t(const Scenario& scenario, const coupling::CoSimulation& sim, std::size_t k);
 
 }  // namespace dipper::scenario

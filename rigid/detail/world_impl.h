@@ -126,6 +126,7 @@ struct RigidWorld::Impl {
     MaterialPairs pairs;
     std::size_t checked_bodies = 0;  // bodies whose material pairs have been checked
     double time_s = 0.0;
+    double step_s = 0.0;  ///< length of the last step (RigidWorld::last_step_s)
     std::uint64_t step_count = 0;
     std::vector<Vec3> contact_force;
     std::vector<btVector3> velocity_before, spin_before;  // of each rock at the start of the last step
@@ -230,7 +231,7 @@ void add_plate_hulls(btCompoundShape& compound, std::vector<std::unique_ptr<btCo
 
 /// The shovel's part of a checkpoint (rope_shovel.cpp).
 void write_shovel_state(const ShovelState& s, StateWriter& out);
-void read_shovel_state(ShovelState& s, StateReader& in);
+void read_shovel_state(ShovelState& s, StateReader& in, double last_step_s);
 
 // The rope shovel's share of a step (rope_shovel.cpp): motor targets and rope forces before Bullet steps,
 // drive forces read after.

@@ -51,6 +51,7 @@ struct Bed {
               dem::WorldSettings s;
               s.step_s = dt;
               s.threads = threads;
+              s.initial_overlap_tolerance = s.max_overlap_ratio;  // the cached bed was settled: its overlaps are the run's
               return s;
           }()),
           rigid([&] {

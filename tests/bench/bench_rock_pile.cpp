@@ -67,7 +67,6 @@ int main(int argc, char** argv)
     }
     const bool bullet_pairs = pairs == "bullet";
     RigidSettings settings;
-    settings.step_s = settle_dt;
     settings.solver_iterations = iterations;
     settings.contact_pool_size = pool;
     settings.rock_margin_fraction = margin_fraction;
@@ -99,7 +98,7 @@ int main(int argc, char** argv)
     using clock = std::chrono::steady_clock;
     const auto t0 = clock::now();
     const int settle_steps = static_cast<int>(std::lround(settle_s / settle_dt));
-    for (int k = 0; k < settle_steps; ++k) w.step();
+    for (int k = 0; k < settle_steps; ++k) w.step(settle_dt);
     const double settle_wall = std::chrono::duration<double>(clock::now() - t0).count();
     std::printf("rocks %d  settled %.1f s at %g s (%.1f s wall), %d thread(s)\n", rocks, settle_s, settle_dt, settle_wall, threads);
 
@@ -108,13 +107,12 @@ int main(int argc, char** argv)
             std::fprintf(stderr, "--dt needs steps > 0\n");
             return 2;
         }
-        w.set_step_s(dt);
-        for (int k = 0; k < 100; ++k) w.step();  // let the contact impulses adapt to the new step
+        for (int k = 0; k < 100; ++k) w.step(dt);  // let the contact impulses adapt to the new step
         std::vector<double> per_step;
         double reaction = 0.0;
         for (int k = 0; k < steps; ++k) {
             const auto a = clock::now();
-            w.step();
+            w.step(dt);
             per_step.push_back(std::chrono::duration<double>(clock::now() - a).count());
             reaction += -w.contact_force_N(ground).z;
         }

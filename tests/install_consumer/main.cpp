@@ -25,7 +25,7 @@ int main()
     rocks.set_pair("rock", "ground", 0.9, 0.0);
     rocks.add_ground_plane(0.0, 1, "ground");
     const rigid::BodyId rock = rocks.add_rock(rigid::generate_rock({0.4, 1.0, 1.5, 20}, 7), 2700.0, 0, {0, 0, 1.0});
-    for (int k = 0; k < 1500; ++k) rocks.step();
+    for (int k = 0; k < 1500; ++k) rocks.step(1e-3);
     const double rock_z = rocks.state(rock).position_m.z;
     std::printf("rock at rest with its centre at z = %.4f m\n", rock_z);
 

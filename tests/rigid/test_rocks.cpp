@@ -45,10 +45,9 @@ RigidWorld rock_world(const RigidSettings& s, const std::string& other, double r
 }
 
 /// A world with materials rock and ground and their pairs.
-RigidWorld rock_world(double step_s, double friction = 0.6, int iterations = 10)
+RigidWorld rock_world(double friction = 0.6, int iterations = 10)
 {
     RigidSettings s;
-    s.step_s = step_s;
     s.solver_iterations = iterations;
     return rock_world(s, "ground", friction, 0.2, friction, 0.2);
 }
@@ -205,7 +204,7 @@ TEST_CASE("the collision margin does not change a rock's size: the rounded shape
     // sees) and of the extent in 200 random directions, over 40 rocks of 300 mm with elongation up to 2.
     // Measured: volume 0.32 %, principal extents 1.3 %, any direction 1.5 % (the shrunk hull's corners,
     // rounded by the margin, fall short of the sharpest true corners by m (1 / sin(half angle) - 1)).
-    RigidWorld w = rock_world(1e-3);
+    RigidWorld w = rock_world();
     double worst_volume = 0.0, worst_extent = 0.0, worst_axis = 0.0;
     std::mt19937 rng(4);
     std::normal_distribution<double> g;
@@ -242,18 +241,18 @@ TEST_CASE("a rock resting on the ground carries its weight (1 %) at its true hei
         for (const bool mesh_floor : {false, true}) {
             for (std::uint64_t seed : {3u, 8u}) {
                 CAPTURE(dt, mesh_floor, seed);
-                RigidWorld w = rock_world(dt);
+                RigidWorld w = rock_world();
                 const BodyId floor = mesh_floor ? w.add_static_mesh(meshes::make_plate_mesh(4.0, 4.0, 8, 8), 1, "floor",
                                                                     Mat3::identity(), {-2.0, -2.0, 0.0})
                                                 : w.add_ground_plane(0.0, 1, "ground");
                 const ConvexPolyhedron r = generate_rock({0.4, 1.0, 1.6, 20}, seed);
                 const BodyId rock = w.add_rock(r, 2700.0, 0, {0.0, 0.0, 0.4});
                 const int settle = static_cast<int>(2.0 / dt);
-                for (int k = 0; k < settle; ++k) w.step();
+                for (int k = 0; k < settle; ++k) w.step(dt);
                 Vec3 sum;
                 const Vec3 before = w.state(rock).position_m;
                 for (int k = 0; k < 100; ++k) {
-                    w.step();
+                    w.step(dt);
                     sum += w.contact_force_N(floor);
                 }
                 const double weight = w.mass_kg(rock) * 9.81;
@@ -275,14 +274,14 @@ TEST_CASE("rock friction is the pair's coefficient, not Bullet's product: slidin
     const Mat3 incline = rotation_about_axis({0, 1, 0}, -tilt);  // surface falling towards +x
     for (const double mu : {0.6, 0.3}) {
         CAPTURE(mu);
-        RigidWorld w = rock_world(1e-3, mu);
+        RigidWorld w = rock_world(mu);
         w.add_static_mesh(meshes::make_plate_mesh(6.0, 2.0, 6, 2), 1, "incline", incline, incline * Vec3{-3.0, -1.0, 0.0});
         const ConvexPolyhedron c = cube(0.3);
         const Vec3 up = incline * Vec3{0, 0, 1};
         const BodyId rock = w.add_rock(c, 2700.0, 0, up * 0.15, incline);
-        for (int k = 0; k < 200; ++k) w.step();
+        for (int k = 0; k < 200; ++k) w.step(1e-3);
         const Vec3 v0 = w.state(rock).velocity_m_per_s;
-        for (int k = 0; k < 500; ++k) w.step();
+        for (int k = 0; k < 500; ++k) w.step(1e-3);
         const Vec3 v1 = w.state(rock).velocity_m_per_s;
         const double a = norm(v1 - v0) / 0.5;
         if (mu == 0.6) CHECK(norm(v1) < 1e-3);
@@ -293,34 +292,34 @@ TEST_CASE("rock friction is the pair's coefficient, not Bullet's product: slidin
 TEST_CASE("rigid world: a missing material pair is found among new and old bodies alike", "[rigid][unit][bad_input]")
 {
     // rock_world sets rock-rock and rock-ground; "ice" gets a pair with the ground only
-    RigidWorld w = rock_world(1e-3);
+    RigidWorld w = rock_world();
     w.add_material("ice");
     w.set_pair("ice", "ground", 0.1, 0.0);
     w.add_ground_plane(0.0, w.material_index("ground"), "ground");
     w.add_rock(cube(0.3), 2700.0, w.material_index("rock"), {0.0, 0.0, 1.0});
     w.add_rock(cube(0.3), 900.0, w.material_index("ice"), {5.0, 0.0, 1.0});
     // one ice rock: it meets the rock (ice-rock unset)
-    CHECK_THROWS_WITH(w.step(), (Catch::Contains("rock-ice") || Catch::Contains("ice-rock")) && Catch::Contains("set_pair"));
+    CHECK_THROWS_WITH(w.step(1e-3), (Catch::Contains("rock-ice") || Catch::Contains("ice-rock")) && Catch::Contains("set_pair"));
     w.set_pair("ice", "rock", 0.2, 0.0);
-    w.step();  // one ice rock needs no ice-ice pair
+    w.step(1e-3);  // one ice rock needs no ice-ice pair
     // a second ice rock, new: the old one now meets an ice rock, and the error names both
     w.add_rock(cube(0.3), 900.0, w.material_index("ice"), {10.0, 0.0, 1.0});
-    CHECK_THROWS_WITH(w.step(), Catch::Contains("ice-ice") && Catch::Contains("set_pair"));
+    CHECK_THROWS_WITH(w.step(1e-3), Catch::Contains("ice-ice") && Catch::Contains("set_pair"));
     w.set_pair("ice", "ice", 0.1, 0.0);
-    w.step();
+    w.step(1e-3);
     // a body of an unpaired material added after the others were checked: the old rocks meet it
     w.add_material("steel");
     w.add_static_mesh(meshes::make_plate_mesh(1, 1, 1, 1), w.material_index("steel"), "late_plate");
-    CHECK_THROWS_WITH(w.step(), Catch::Contains("'late_plate'") && Catch::Contains("-steel"));
+    CHECK_THROWS_WITH(w.step(1e-3), Catch::Contains("'late_plate'") && Catch::Contains("-steel"));
 }
 
 TEST_CASE("rigid world: bad input gives clear errors", "[rigid][unit][bad_input]")
 {
-    RigidWorld w = rock_world(1e-3);
+    RigidWorld w = rock_world();
     w.add_material("steel");  // no pairs set for steel
     const BodyId bucket = w.add_static_mesh(meshes::make_plate_mesh(1, 1, 1, 1), w.material_index("steel"), "bucket");
     w.add_rock(cube(0.3), 2700.0, 0, {0.5, 0.5, 1.0});
-    CHECK_THROWS_WITH(w.step(), Catch::Contains("'bucket'") && Catch::Contains("rock-steel") && Catch::Contains("set_pair"));
+    CHECK_THROWS_WITH(w.step(1e-3), Catch::Contains("'bucket'") && Catch::Contains("rock-steel") && Catch::Contains("set_pair"));
     CHECK_THROWS_WITH(w.material_index("stell"), Catch::Contains("'stell' is not defined") && Catch::Contains("steel"));
     CHECK_THROWS_WITH(w.add_rock(cube(0.3).transformed(Mat3::identity(), {1, 0, 0}), 2700.0, 0, {}),
                       Catch::Contains("not in its principal frame"));
@@ -328,9 +327,7 @@ TEST_CASE("rigid world: bad input gives clear errors", "[rigid][unit][bad_input]
     CHECK_THROWS_WITH(w.add_rock(cube(0.3), 2700.0, 9, {}), Catch::Contains("material index 9"));
     CHECK_THROWS_WITH(w.set_kinematic_pose(bucket, Mat3::identity(), {}), Catch::Contains("not a kinematic mesh"));
     CHECK_THROWS_WITH(w.set_pair("rock", "steel", 0.5, 1.5), Catch::Contains("restitution"));
-    RigidSettings bad;
-    bad.step_s = 0.0;
-    CHECK_THROWS_WITH(RigidWorld(bad), Catch::Contains("step_s"));
+    CHECK_THROWS_WITH(w.step(0.0), Catch::Contains("step_s"));
     RigidSettings no_threads;
     no_threads.threads = 0;
     CHECK_THROWS_WITH(RigidWorld(no_threads), Catch::Contains("threads is 0") && Catch::Contains("1..1024"));
@@ -347,7 +344,7 @@ struct PileResult {
 /// 100 steps measured.
 PileResult settle_pile(int count, double settle_s)
 {
-    RigidWorld w = rock_world(1e-3, 0.85);
+    RigidWorld w = rock_world(0.85);
     const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
     PileResult r{0.0, 0.0, 0.0, 0.0};
     for (int k = 0; k < count; ++k) {
@@ -357,10 +354,10 @@ PileResult settle_pile(int count, double settle_s)
                                      rotation_about_axis({0.0, 0.0, 1.0}, 0.7 * k));
         r.mass_kg += w.mass_kg(id);
     }
-    for (int k = 0; k < static_cast<int>(std::lround(settle_s / 1e-3)); ++k) w.step();
+    for (int k = 0; k < static_cast<int>(std::lround(settle_s / 1e-3)); ++k) w.step(1e-3);
     Vec3 sum;
     for (int k = 0; k < 100; ++k) {
-        w.step();
+        w.step(1e-3);
         sum += w.contact_force_N(ground);
         r.deepest_m = std::max(r.deepest_m, w.max_penetration_m());
     }
@@ -409,7 +406,6 @@ Throw throw_rocks(std::uint64_t seed, bool onto_plate, bool bullet_pairs, int th
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     RigidSettings s;
-    s.step_s = 1e-3;
     s.gravity_m_per_s2 = onto_plate ? Vec3{0.0, 0.0, -9.81} : Vec3{};
     s.bullet_convex_pairs = bullet_pairs;
     s.threads = threads;
@@ -430,7 +426,7 @@ Throw throw_rocks(std::uint64_t seed, bool onto_plate, bool bullet_pairs, int th
     const Vec3 v0 = w.state(rocks[0]).velocity_m_per_s;
     Throw t;
     for (int k = 0; k < 1500; ++k) {
-        w.step();
+        w.step(1e-3);
         t.steps_with_contact += w.contact_point_count() > 0 ? 1 : 0;
     }
     for (BodyId r : rocks) t.states.push_back(w.state(r));
@@ -480,7 +476,6 @@ struct Drop {
 Drop drop_into_box(int threads, bool bullet_pairs)
 {
     RigidSettings s;
-    s.step_s = 1e-3;
     s.threads = threads;
     s.bullet_convex_pairs = bullet_pairs;
     RigidWorld w = rock_world(s, "ground", 0.85, 0.1, 0.8, 0.1);
@@ -494,7 +489,7 @@ Drop drop_into_box(int threads, bool bullet_pairs)
         rocks.push_back(w.add_rock(r, 2700.0, 0, {0.25 + 0.42 * i, 0.25 + 0.42 * j, 0.5 + 0.9 * layer},
                                    rotation_about_axis(normalized(Vec3{1.0, 0.3 * (k % 3), 0.5}), 0.9 * k)));
     }
-    for (int k = 0; k < 500; ++k) w.step();
+    for (int k = 0; k < 500; ++k) w.step(1e-3);
     Drop d;
     for (BodyId r : rocks) d.states.push_back(w.state(r));
     d.box_force = w.contact_force_N(box);
@@ -575,7 +570,6 @@ TEST_CASE("the solver's groups move rocks exactly as Bullet's islands do where b
     };
     auto drop = [](bool islands) {
         RigidSettings s;
-        s.step_s = 1e-3;
         RigidWorld w = rock_world(s, "ground", 0.6, 0.3, 0.6, 0.3);
         const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
         if (islands) {
@@ -594,7 +588,7 @@ TEST_CASE("the solver's groups move rocks exactly as Bullet's islands do where b
                                        {0.5 * ((k % 3) - 1.0), 0.3, 0.0}, Vec3{2.0, -1.0 + 0.3 * k, 0.5}));
         Run r;
         for (int k = 0; k < 1000; ++k) {
-            w.step();
+            w.step(1e-3);
             r.steps_with_contact += w.contact_point_count() > 0 ? 1 : 0;
         }
         for (BodyId b : rocks) r.states.push_back(w.state(b));
@@ -627,7 +621,6 @@ TEST_CASE("rocks on moving kinematic plates end with the same bits on 1, 2 and 3
     };
     auto run = [](int threads) {
         RigidSettings s;
-        s.step_s = 1e-3;
         s.threads = threads;
         RigidWorld w = rock_world(s, "ground", 0.7, 0.2, 0.7, 0.2);
         w.add_ground_plane(0.0, 1, "ground");
@@ -648,7 +641,7 @@ TEST_CASE("rocks on moving kinematic plates end with the same bits on 1, 2 and 3
             for (int p = 0; p < 4; ++p)
                 w.set_kinematic_pose(plates[static_cast<std::size_t>(p)], rotation_about_axis({0.0, 1.0, 0.0}, (p % 2 ? 0.3 : -0.3) * t),
                                      {1.8 * p, 0.0, 0.05 + 0.2 * t});
-            w.step();
+            w.step(1e-3);
         }
         Run r;
         for (BodyId b : rocks) r.states.push_back(w.state(b));
@@ -681,7 +674,6 @@ Throw throw_at_surface(std::uint64_t seed, bool mesh, bool spin, int threads)
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     RigidSettings s;
-    s.step_s = 1e-3;
     s.threads = threads;
     RigidWorld w = rock_world(s, "ground", 0.7, 0.3, 0.6, 0.4);
     const BodyId surface = mesh ? w.add_static_mesh(meshes::make_open_box_mesh(4.0, 4.0, 3.0, 1.0), 1, "box")
@@ -706,7 +698,7 @@ Throw throw_at_surface(std::uint64_t seed, bool mesh, bool spin, int threads)
     Throw t;
     const Vec3 v0 = w.state(rock).velocity_m_per_s;
     for (int k = 0; k < 1200; ++k) {
-        w.step();
+        w.step(1e-3);
         t.steps_with_contact += norm(w.contact_force_N(surface)) > 0.0 ? 1 : 0;
         t.points_per_step.push_back(w.contact_point_count());
     }

@@ -18,11 +18,9 @@ namespace {
 
 constexpr double kG = 9.81;
 
-RigidWorld shovel_world(double step_s = 1e-3)
+RigidWorld shovel_world()
 {
-    RigidSettings s;
-    s.step_s = step_s;
-    RigidWorld w(s);
+    RigidWorld w;
     w.add_material("rock");
     w.add_material("steel");
     w.add_material("ground");
@@ -82,7 +80,7 @@ TEST_CASE("the dipper at rest with an 80 t payload: hoist and crowd forces equal
         const double hoist = pose_shovel(g, dipper, angle_guess, crowd).rope_length_m;
         RigidWorld w = shovel_world();
         w.add_rope_shovel(dipper, g, hold(hoist, crowd), w.material_index("steel"));
-        for (int k = 0; k < 4000; ++k) w.step();  // rope oscillation damped out (ratio 0.2, 3 Hz)
+        for (int k = 0; k < 4000; ++k) w.step(1e-3);  // rope oscillation damped out (ratio 0.2, 3 Hz)
         const ShovelReading r = w.shovel_reading();
         CAPTURE(angle_guess, r.handle_angle_deg);
 
@@ -131,7 +129,7 @@ TEST_CASE("the rake angle measured on the posed model equals the configured one"
         RigidWorld w = shovel_world();
         w.add_rope_shovel(dipper, g, default_loading_cycle(g, dipper), w.material_index("steel"));
         for (int k = 0; k < 20000; ++k) {  // through the dig and the swing: many poses
-            w.step();
+            w.step(1e-3);
             if (k % 1000 == 0) CHECK(w.shovel_reading().rake_angle_deg == Approx(rake).margin(1e-6));
         }
     }
@@ -149,7 +147,7 @@ TEST_CASE("a rope never pushes: paid out beyond reach, the dipper rests on the g
     w.add_rope_shovel(dipper, g, hold(hoist, 8.0), w.material_index("steel"));
     int slack_steps = 0;
     for (int k = 0; k < 4000; ++k) {
-        w.step();
+        w.step(1e-3);
         const ShovelReading& r = w.shovel_reading();
         CHECK(r.rope_tension_N[0] >= 0.0);
         CHECK(r.rope_tension_N[1] >= 0.0);
@@ -183,7 +181,7 @@ TEST_CASE("the default cycle: three passes in 138 s with 15 s digs, the shovel f
     w.add_rope_shovel(dipper, g, cycle, w.material_index("steel"));
     double crowd_error = 0.0, swing_error = 0.0;
     for (int k = 0; k < 46000; ++k) {
-        w.step();
+        w.step(1e-3);
         const ShovelReading& r = w.shovel_reading();
         const MotionSample m = cycle.at(r.time_s);
         crowd_error = std::max(crowd_error, std::abs(r.crowd_extension_m - m.crowd_extension_m));
@@ -274,7 +272,7 @@ TEST_CASE("the shovel follows its curves while digging through a rock pile", "[r
     int dipper_contacts = 0;
     const RigidWorld::ShovelParts parts = w.add_rope_shovel(dipper, g, cycle, w.material_index("steel"));
     for (int k = 0; k < 8000; ++k) {
-        w.step();
+        w.step(1e-3);
         const ShovelReading& r = w.shovel_reading();
         const MotionSample m = cycle.at(r.time_s);
         crowd_error = std::max(crowd_error, std::abs(r.crowd_extension_m - m.crowd_extension_m));
@@ -417,8 +415,8 @@ TEST_CASE("propel: the machine moves along its heading as the curve says, and th
     b.add_rope_shovel(dipper, g, propel_hold, b.material_index("steel"), start, 30.0);
     const Vec3 forward{std::cos(30.0 * M_PI / 180.0), std::sin(30.0 * M_PI / 180.0), 0.0};
     for (int k = 0; k < 600; ++k) {
-        a.step();
-        b.step();
+        a.step(1e-3);
+        b.step(1e-3);
         if (k == 299) {  // t = 0.3 s: halfway
             Mat3 ra, rb;
             Vec3 oa, ob;
@@ -467,7 +465,7 @@ TEST_CASE("a wall that does not block the machine leaves the shovel as if it wer
             if (walls == 1) w.set_blocks_machine(id, false);
         }
         w.add_rope_shovel(dipper, g, hold_pose, w.material_index("steel"));
-        for (int k = 0; k < 300; ++k) w.step();
+        for (int k = 0; k < 300; ++k) w.step(1e-3);
         return std::make_pair(w.shovel_reading().hoist_force_filtered_N, w.shovel_reading().crowd_force_filtered_N);
     };
     const auto free = forces_after(0), through = forces_after(1), blocked = forces_after(2);

@@ -7,7 +7,6 @@
 #include "rigid/convex_polyhedron.h"
 #include "rigid/motion_curves.h"
 #include "rigid/rope_shovel.h"
-#include "scenario/rigid_scene.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
 #include "scenario/helpers.h"
@@ -215,8 +214,8 @@ TEST_CASE("materials.rock_pairs set the rocks' coefficients in Bullet over the p
                               "    - {materials: [ground, rock], friction: 0.3, restitution: 0.2}\n";
     const Scenario s = parse_scenario(base(mixed + pairs), "case.yaml", ".");
     REQUIRE(s.rock_pairs.size() == 2);
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
     const rigid::RigidWorld& w = scene.rigid();
     const int rock = w.material_index("rock"), ground = w.material_index("ground"), bucket = w.material_index("bucket");
     CHECK(w.pair_friction(rock, rock) == 1.1);
@@ -230,9 +229,8 @@ TEST_CASE("materials.rock_pairs set the rocks' coefficients in Bullet over the p
         const Scenario one = parse_scenario(base(mixed + "materials:\n  rock_pairs:\n    - {materials: [rock, " + name +
                                                  "], friction: 0.7}\n"),
                                             "case.yaml", ".");
-        auto one_dem = build_world(one);
-        RigidScene with(one, *one_dem);
-        CHECK(with.rigid().pair_friction(with.rigid().material_index("rock"), with.rigid().material_index(name)) == 0.7);
+        const auto with = build_co_simulation(one, build_world(one));
+        CHECK(with->rigid().pair_friction(with->rigid().material_index("rock"), with->rigid().material_index(name)) == 0.7);
     }
 
     std::string e = error_of(base(mixed + std::regex_replace(pairs, std::regex("\\[ground, rock\\]"), "[ground, bucket]")));
@@ -256,9 +254,9 @@ TEST_CASE("fills[].rock_points sets how many points each rock's hull is drawn fr
                               "    sizes: [{radius_m: 0.1, mass_fraction: 0.5}]\n    rocks: [{size_m: 0.3, mass_fraction: 0.5}]\n";
     const auto most_vertices = [&](const std::string& extra) {
         const Scenario s = parse_scenario(base(mixed + extra), "case.yaml", ".");
-        auto dem = build_world(s);
-        RigidScene scene(s, *dem);
-        scene.fill_mixed(s);
+        const auto sim = build_co_simulation(s, build_world(s));
+        coupling::CoSimulation& scene = *sim;
+        fill_rocks(s, scene);
         REQUIRE(scene.coupled().rocks().size() > 10);
         std::size_t most = 0;
         for (const coupling::RockRecord& r : scene.coupled().rocks()) most = std::max(most, r.shape.vertices_m().size());
@@ -279,8 +277,7 @@ TEST_CASE("rocks and walls the rigid world cannot hold are refused with the wall
                                "poisson_ratio: 0.45}\n  pairs:\n    - {materials: [ore, rubber], friction: 0.8}\n";
     Scenario t = parse_scenario(base(mixed + rubber), "case.yaml", ".");
     t.planes.push_back({"chute", "rubber", {0, 0, 0}, {1, 0, 0}});
-    auto dem = build_world(t);
-    CHECK_THROWS_WITH(RigidScene(t, *dem), Catch::Contains("rocks meet wall 'chute' of material 'rubber'") &&
+    CHECK_THROWS_WITH(build_co_simulation(t, build_world(t)), Catch::Contains("rocks meet wall 'chute' of material 'rubber'") &&
                                                Catch::Contains("rock, ground, bucket, truck, steel"));
 }
 
@@ -313,8 +310,8 @@ output: {vtk_interval_s: 0}
 
     // loaded whole, spheres sit deep in the steel: the first step stops on the overlap
     {
-        auto dem = build_world(s);
-        RigidScene scene(s, *dem);
+        const auto sim = build_co_simulation(s, build_world(s));
+        coupling::CoSimulation& scene = *sim;
         const coupling::LoadedState all = coupling::load_state(scene.coupled(), s.pile);
         REQUIRE(all.spheres == n);
         CHECK_THROWS_WITH(scene.step(), Catch::Contains("overlaps wall"));
@@ -323,8 +320,9 @@ output: {vtk_interval_s: 0}
     // ground is 0.15 m below the lowest sphere)
     std::size_t left_out = 0;
     {
-        auto dem = build_world(s);
-        RigidScene scene(s, *dem);
+        const auto sim = build_co_simulation(s, build_world(s));
+        coupling::CoSimulation& scene = *sim;
+        dem::World* const dem = &scene.dem();
         const coupling::LoadedState kept =
             coupling::load_state(scene.coupled(), s.pile, [&scene](const Vec3& c, double r) { return scene.clear_of_machine(c, r); });
         left_out = kept.spheres_left_out;
@@ -368,7 +366,7 @@ output: {vtk_interval_s: 0}
         return radius;
     };
     // how many bodies of a fill the dipper's or door's surface passes within reach of
-    auto count_in_steel = [&](const RigidScene& scene, const dem::World& dem) {
+    auto count_in_steel = [&](const coupling::CoSimulation& scene, const dem::World& dem) {
         std::size_t n = 0;
         for (std::size_t i = 0; i < dem.particles().size(); ++i)
             n += !scene.clear_of_machine(dem.particles().position_m[i], dem.particles().radius_m[i]);
@@ -378,8 +376,9 @@ output: {vtk_interval_s: 0}
     };
     // the same fill placed without regard to the machine: bodies sit in the steel
     {
-        auto dem = build_world(s);
-        RigidScene scene(s, *dem);
+        const auto sim = build_co_simulation(s, build_world(s));
+        coupling::CoSimulation& scene = *sim;
+        dem::World* const dem = &scene.dem();
         const FillSpec& f = s.fills[0];
         coupling::MixedDistribution d;
         d.sphere_radius_m = 0.15;
@@ -393,9 +392,10 @@ output: {vtk_interval_s: 0}
         CHECK(count_in_steel(scene, *dem) > 10);
     }
     // as a run fills it: none, the same mass, and the first step finds no body in the steel
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
-    scene.fill_mixed(s);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
+    fill_rocks(s, scene);
     CHECK(count_in_steel(scene, *dem) == 0);
     REQUIRE(scene.coupled().rocks().size() > 20);
     REQUIRE(dem->particles().size() > 200);
@@ -416,8 +416,9 @@ TEST_CASE("material held in the dipper: its weight on dipper and door, the mass 
     const std::string dir = (fs::temp_directory_path() / "dipper_held_material").string();
     const std::string text = held_in_dipper(dir, 2.4, 2.0, "sizes: [{radius_m: 0.15, mass_fraction: 1}]");
     const Scenario s = parse_scenario(text, "held.yaml", dir);
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     build_particles(s, *dem);
     REQUIRE(dem->particles().size() > 40);
     const double mass = dem->total_mass_kg();
@@ -437,7 +438,7 @@ TEST_CASE("material held in the dipper: its weight on dipper and door, the mass 
 
     // every sphere is in the dipper: the probe counts all of them, and the fill factor is their mass over
     // the bulk density times the 42 m3 struck volume
-    const BucketContents b = scene.bucket();
+    const coupling::BucketContents b = scene.bucket();
     CHECK(b.spheres == dem->particles().size());
     CHECK(b.mass_kg == Approx(mass).epsilon(1e-12));
     CHECK(b.fill_factor == Approx(mass / (1903.0 * dipper.struck_volume_m3)).epsilon(1e-12));
@@ -462,7 +463,7 @@ TEST_CASE("material held in the dipper: its weight on dipper and door, the mass 
     CHECK(scene.passes().empty());
     while (scene.coupled().time_s() < 2.4) scene.step();
     REQUIRE(scene.passes().size() == 1);
-    const PassRecord& p = scene.passes()[0];
+    const coupling::PassRecord& p = scene.passes()[0];
     CHECK(p.dump_s > 2.0);
     CHECK(p.dump_s < 2.15);  // 5 deg of the 30 deg opening reached at 2.05 s, plus the door's lag
     CHECK(p.mass_kg == Approx(mass).epsilon(0.02));  // at 5 deg open, at most a few spheres have left
@@ -482,10 +483,11 @@ TEST_CASE("the interface force of spheres and rocks held in the dipper is their 
         held_in_dipper(dir, 3.0, 0.0, "sizes: [{radius_m: 0.15, mass_fraction: 0.7}], rocks: [{size_m: 0.4, mass_fraction: 0.3}]") +
             concat("coupling: {substeps: ", substeps, "}\n"),
         "held_rocks.yaml", dir);
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     build_particles(s, *dem);
-    scene.fill_mixed(s);
+    fill_rocks(s, scene);
     REQUIRE(!scene.coupled().rocks().empty());
     const double sphere_weight = dem->total_mass_kg() * 9.81;
     double rock_weight = 0.0;
@@ -537,8 +539,9 @@ TEST_CASE("the force on the lip and its teeth is told from the rest of the dippe
                               "box: {min_m: [-30, -1, 0], max_m: [-28, 1, 2]}");
     text = std::regex_replace(text, std::regex("mass_kg: 2500"), "mass_kg: 200");
     const Scenario s = parse_scenario(text, "lip.yaml", dir);
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     build_particles(s, *dem);
     Mat3 r;
     Vec3 o;
@@ -584,8 +587,9 @@ rigid::ConvexPolyhedron cube_rock(double edge_m)
 TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a diagnosis", "[scenario][shovel]")
 {
     const Scenario s = parse_scenario(base("shovel: {element_size_m: 0.3}\n"), "case.yaml", ".");
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     build_particles(s, *dem);
     scene.step();
     CHECK_NOTHROW(scene.check_tunnelling());  // no rocks: nothing to check
@@ -607,9 +611,10 @@ TEST_CASE("among many rocks on two threads, the first rock in order inside the s
     // machine, and rocks 150, 451 and 599 in the bottom plate. Each thread finds its own; the first of all is named.
     const Scenario s = parse_scenario(std::regex_replace(base("shovel: {element_size_m: 0.3}\n"), std::regex("threads: 1"), "threads: 2"),
                                       "case.yaml", ".");
-    auto dem = build_world(s);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     REQUIRE(dem->threads() == 2);
-    RigidScene scene(s, *dem);
     build_particles(s, *dem);
     scene.step();
     const rigid::ConvexPolyhedron cube = cube_rock(0.3);
@@ -763,10 +768,11 @@ fills:
      sizes: [{radius_m: 0.08, mass_fraction: 0.5}], rocks: [{size_m: 0.3, mass_fraction: 0.5}]}
 )");
     const Scenario s = parse_scenario(text, "lift.yaml", ".");
-    auto dem = build_world(s);
-    RigidScene scene(s, *dem);
+    const auto sim = build_co_simulation(s, build_world(s));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     build_particles(s, *dem);
-    scene.fill_mixed(s);
+    fill_rocks(s, scene);
     REQUIRE(scene.coupled().rocks().size() >= 5);
     while (scene.coupled().time_s() < 1.2) scene.step();
     // after 1.2 s the platform's top is at 0.6 m and everything rests on it: every rock above it, and
@@ -831,8 +837,9 @@ TEST_CASE("a pile saved cut at a height and loaded by another scenario holds wha
     UNSCOPED_INFO("saved pile: " << spheres << " spheres, " << rocks << " rocks");
 
     const Scenario reuse = load_scenario((dir / "reuse.yaml").string());
-    auto dem = build_world(reuse);
-    RigidScene scene(reuse, *dem);
+    const auto sim = build_co_simulation(reuse, build_world(reuse));
+    coupling::CoSimulation& scene = *sim;
+    dem::World* const dem = &scene.dem();
     coupling::load_state(scene.coupled(), reuse.pile);
     CHECK(dem->particles().size() == spheres);
     CHECK(scene.coupled().rocks().size() == rocks);
@@ -880,7 +887,7 @@ TEST_CASE("the dig-and-return cycle digs like the default cycle, empties the dip
     }
     CHECK_THROWS_WITH(rigid::dig_and_return_cycle(g, dipper, 0), Catch::Contains("cycles = 0"));
     // a faster dig keeps the pass's other 15 s
-    const rigid::MotionCurves fast = dig_speed_scaled(wear, 1.5, rigid::kDigAndReturnPass_s);
+    const rigid::MotionCurves fast = coupling::dig_speed_scaled(wear, 1.5, rigid::kDigAndReturnPass_s);
     CHECK(fast.duration_s() == Approx(3 * (15.0 + 10.0) + 29.99 - 15.0 + 10.0).epsilon(1e-12));
 }
 
@@ -890,7 +897,7 @@ TEST_CASE("a faster dig shortens each pass's dig and keeps the poses and the res
     const meshes::Dipper dipper = meshes::make_dipper({});
     const rigid::MotionCurves cycle = rigid::default_loading_cycle(g, dipper);
     const double factor = 1.3;
-    const rigid::MotionCurves fast = dig_speed_scaled(cycle, factor);
+    const rigid::MotionCurves fast = coupling::dig_speed_scaled(cycle, factor);
     REQUIRE(fast.samples().size() == cycle.samples().size());
     const double pass = 31.0 + 15.0 / factor;
     CHECK(fast.duration_s() == Approx(2.0 * pass + 45.99 - 15.0 + 15.0 / factor).epsilon(1e-12));
@@ -910,5 +917,5 @@ TEST_CASE("a faster dig shortens each pass's dig and keeps the poses and the res
     // the dig of the second pass runs from 46 s to 61 s in the default cycle, from 42.5 s to 54.1 s here
     const rigid::MotionSample mid_default = cycle.at(46.0 + 7.5), mid_fast = fast.at(pass + 7.5 / factor);
     CHECK(mid_fast.hoist_length_m == Approx(mid_default.hoist_length_m).epsilon(1e-12));
-    CHECK(dig_speed_scaled(cycle, 1.0).samples().size() == cycle.samples().size());
+    CHECK(coupling::dig_speed_scaled(cycle, 1.0).samples().size() == cycle.samples().size());
 }

@@ -29,7 +29,6 @@ RockWearRun slide_rocks(double step_s, int iterations, bool slabs)
 {
     const double mu = 0.53, phi = 1e-12, size = 4.0, height = 0.8, thick = 0.05;
     RigidSettings settings;
-    settings.step_s = step_s;
     settings.solver_iterations = iterations;
     RigidWorld w(settings);
     w.add_material("rock");
@@ -63,7 +62,7 @@ RockWearRun slide_rocks(double step_s, int iterations, bool slabs)
         const double x = t < settle ? 0.0 : 0.3 * std::sin(2.0 * M_PI * (t - settle));
         const double v = t < settle ? 0.0 : 0.3 * 2.0 * M_PI * std::cos(2.0 * M_PI * (t - settle));
         w.set_kinematic_pose(bucket, Mat3::identity(), {x, 0.0, 0.0});
-        w.step();
+        w.step(step_s);
         if (t <= settle) continue;
         wear.accumulate(w.surface_contacts(bucket, 0, &surface), step_s);
         for (const BodyId r : rocks) {
@@ -116,9 +115,8 @@ TEST_CASE("a rock landing flat is one impact, with its approach speed", "[wear][
     // landing speed sqrt(2 g h); the record's speed is the rock's at the start of the landing step, short
     // of it by at most g dt (0.4 % at 1e-3 s): tolerance 1 %.
     const double K = 1e-12, h = 0.3;
-    RigidSettings settings;
-    settings.step_s = 1e-3;
-    RigidWorld w(settings);
+    constexpr double step_s = 1e-3;
+    RigidWorld w;
     w.add_material("rock");
     w.add_material("steel");
     w.set_pair("rock", "steel", 0.5, 0.0);
@@ -129,10 +127,10 @@ TEST_CASE("a rock landing flat is one impact, with its approach speed", "[wear][
     wear::WearSurface wear("floor", surface, wear::WearLaw::from_name("impact_energy", K, "test"), 0);
     int impacts = 0;
     for (int k = 0; k < 1500; ++k) {
-        w.step();
+        w.step(step_s);
         const std::vector<ContactRecord> records = w.surface_contacts(floor, 0, &surface);
         for (const ContactRecord& c : records) impacts += c.first_step;
-        wear.accumulate(records, settings.step_s);
+        wear.accumulate(records, step_s);
     }
     CHECK(impacts == 1);
     const double v = std::sqrt(2.0 * 9.81 * h);
@@ -145,10 +143,8 @@ TEST_CASE("a rock landing across two plates of one part is one impact", "[wear][
     // rock lands on both in the same step. An impact is the start of contact between a rock and a part, so
     // it is counted once. Kicked upwards at 1 m/s after it has come to rest, it lifts off about 5 cm and lands
     // again: a second impact, two in all (a count keyed by manifold would give one per plate and landing).
-    RigidSettings settings;
-    settings.step_s = 1e-3;
-    settings.gravity_m_per_s2 = {0.0, 0.0, -9.81};
-    RigidWorld w(settings);
+    constexpr double step_s = 1e-3;
+    RigidWorld w;
     w.add_material("rock");
     w.add_material("steel");
     w.set_pair("rock", "steel", 0.5, 0.0);
@@ -158,8 +154,8 @@ TEST_CASE("a rock landing across two plates of one part is one impact", "[wear][
     const BodyId rock = w.add_rock(cube, 2700.0, 0, {2.0, 2.0, 0.5});
     int impacts = 0, steps_on_both = 0;
     for (int k = 0; k < 1500; ++k) {
-        if (k == 900) w.apply_force(rock, {0.0, 0.0, w.mass_kg(rock) * (9.81 + 1.0 / settings.step_s)}, w.state(rock).position_m);
-        w.step();
+        if (k == 900) w.apply_force(rock, {0.0, 0.0, w.mass_kg(rock) * (9.81 + 1.0 / step_s)}, w.state(rock).position_m);
+        w.step(step_s);
         int on_plate[2] = {0, 0};
         for (const ContactRecord& c : w.surface_contacts(floor, 0)) {
             impacts += c.first_step;
