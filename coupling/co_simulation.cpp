@@ -370,8 +370,8 @@ void CoSimulation::check_tunnelling() const
     throw SimulationError(concat("t = ", coupled_->time_s(), " s: rock ", k, " (", coupled_->rocks()[k].shape.equivalent_diameter_m(),
                                  " m, speed ", norm(rigid_->state(id).velocity_m_per_s), " m/s) has its centre at (", c.x, ", ",
                                  c.y, ", ", c.z, ") m inside plate ", p, " of the ", part == 0 ? "dipper" : "door",
-                                 ": it went through the steel. Reduce time.step_s (now ", dt, " s; try ", dt / 2.0,
-                                 " s) or coupling.substeps (now ", coupled_->settings().substeps, ")"));
+                                 ": it went through the steel. Reduce WorldSettings::step_s (now ", dt, " s; try ", dt / 2.0,
+                                 " s) or CouplingSettings::substeps (now ", coupled_->settings().substeps, ")"));
 }
 
 const rigid::ShovelReading& CoSimulation::reading() const

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dipper::dem {
@@ -116,11 +117,12 @@ void ParticleStore::read_state(StateReader& in, const MaterialTable& materials)
     for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2})
         for (double x : *v)
             if (!(x > 0.0 && std::isfinite(x))) in.fail(concat("a particle radius, mass or inverse of ", x, "; expected a finite value > 0"));
-    std::vector<std::uint8_t> seen(next_id_, 0);
-    for (std::uint32_t i : id) {
-        if (i >= next_id_ || seen[i]) in.fail(concat("particle id ", i, " repeated or not below the next id ", next_id_));
-        seen[i] = 1;
-    }
+    // unique and below the next id, checked on a sorted copy: memory of the particle count, whatever next_id_ says
+    std::vector<std::uint32_t> sorted(id);
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t k = 0; k < sorted.size(); ++k)
+        if (sorted[k] >= next_id_ || (k > 0 && sorted[k] == sorted[k - 1]))
+            in.fail(concat("particle id ", sorted[k], " repeated or not below the next id ", next_id_));
 }
 
 }  // namespace dipper::dem

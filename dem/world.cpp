@@ -459,14 +459,14 @@ void World::finish_step(double dt_s)
             ? concat("; the body behind the wall (", wall.mass_kg, " kg) moves at ", norm(wall.velocity_at(c.point)),
                      " m/s there: if that is far faster than anything drives it, the body has run away (a light body"
                      " coupled with several DEM steps per rigid-body step can, against stiff sphere contacts): the runaway"
-                     " guard (coupling.runaway_guard: true) or fewer steps per rigid-body step (coupling.substeps) keep it stable")
+                     " guard (CouplingSettings::runaway_guard) or fewer DEM steps per rigid-body step (CouplingSettings::substeps) keep it stable")
             : "";
         throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[c.particle], " overlaps wall '",
                                      wall_name(c.wall), "'", c.triangle >= 0 ? concat(" (triangle ", c.triangle, ")") : "",
                                      " by ", ratio, " of its radius (limit ", settings_.max_overlap_ratio, ") at (",
                                      p.x, ", ", p.y, ", ", p.z, "), speed ", norm(particles_.velocity_m_per_s[c.particle]),
                                      " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
-                                     " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall", body));
+                                     " s): reduce WorldSettings::step_s, e.g. to ", 0.5 * step_s_, " s, or slow the wall", body));
     }
     if (max_overlap_ratio_ > settings_.max_overlap_ratio) fail_overlap();
 }
@@ -1636,7 +1636,7 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
                                  ") near (", p.x, ", ", p.y, ", ", p.z, "); relative speed ",
                                  norm(particles_.velocity_m_per_s[i] - particles_.velocity_m_per_s[j]),
                                  " m/s; step_s = ", step_s_, " s (stable limit ", stable_step_limit_s(),
-                                 " s): reduce step_s, e.g. to ", 0.5 * step_s_, " s, or check for particles created inside each other"));
+                                 " s): reduce WorldSettings::step_s, e.g. to ", 0.5 * step_s_, " s, or check for particles created inside each other"));
 }
 
 void World::check_initial_overlaps() const

@@ -5,10 +5,7 @@
 // opens the door. The last line is the pass: the mass the dipper carried and the mean dig force (thesis eq. 11).
 //
 // usage: dipper_dig_one_pass [--threads N]
-#include "core/errors.h"
-#include "coupling/co_simulation.h"
-#include "coupling/mixed_bed.h"
-#include "dem/world.h"
+#include <dipper/dipper.h>
 
 #include <cstdio>
 #include <cstdlib>

@@ -9,7 +9,7 @@ namespace dipper::scenario {
 std::unique_ptr<coupling::CoSimulation> build_co_simulation(const Scenario& s, std::unique_ptr<dem::World> dem)
 {
     coupling::CoSimulationSettings settings;
-    settings.coupling = coupling::CouplingSettings{s.coupling_substeps, s.coupling_runaway_guard};
+    settings.coupling = s.coupling;
     settings.rock_pairs = s.rock_pairs;
     for (const FillSpec& f : s.fills) settings.rocks = settings.rocks || !f.rocks.empty();
     std::unique_ptr<coupling::CoSimulation> sim;

@@ -1,5 +1,7 @@
 #include "scenario/keys.h"
 
+#include "coupling/coupled_world.h"
+
 namespace dipper::scenario {
 
 const std::vector<KeySpec>& scenario_keys()
@@ -104,8 +106,8 @@ const std::vector<KeySpec>& scenario_keys()
         {"pours[].sizes[].mass_fraction", "number", "required", "fraction of the mass"},
 
         {"coupling", "map", "{}", "spheres with rigid bodies (rocks, the shovel)"},
-        {"coupling.substeps", "integer", "5", "DEM steps per rigid-body step (docs/coupling.md)"},
-        {"coupling.runaway_guard", "boolean", "false", "one DEM step per rigid-body step for a while when a rock runs away (docs/coupling.md)"},
+        {"coupling.substeps", "integer", std::to_string(coupling::kDefaultSubsteps), "DEM steps per rigid-body step (docs/coupling.md)"},
+        {"coupling.runaway_guard", "boolean", coupling::CouplingSettings{}.runaway_guard ? "true" : "false", "one DEM step per rigid-body step for a while when a rock runs away (docs/coupling.md)"},
 
         {"shovel", "map", "none", "the rope shovel (docs/machine.md), driven by motion curves"},
         {"shovel.position_m", "vector3", "[0, 0, 0]", "machine origin: on the ground, on the swing axis"},
@@ -181,6 +183,24 @@ std::vector<std::string> child_keys(const std::string& path)
         if (!rest.empty() && rest.find('.') == std::string::npos) names.push_back(rest);
     }
     return names;
+}
+
+const std::vector<std::pair<std::string, std::string>>& library_settings_as_keys()
+{
+    static const std::vector<std::pair<std::string, std::string>> names{
+        {"WorldSettings::step_s", "time.step_s"},
+        {"CouplingSettings::substeps", "coupling.substeps"},
+        {"CouplingSettings::runaway_guard", "coupling.runaway_guard"},
+    };
+    return names;
+}
+
+std::string in_scenario_keys(std::string message)
+{
+    for (const auto& [setting, key] : library_settings_as_keys())
+        for (std::size_t at = message.find(setting); at != std::string::npos; at = message.find(setting, at + key.size()))
+            message.replace(at, setting.size(), key);
+    return message;
 }
 
 }  // namespace dipper::scenario

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dipper::scenario {
@@ -23,5 +24,11 @@ const std::vector<KeySpec>& scenario_keys();
 const KeySpec* find_key(const std::string& path);
 /// The names of the keys directly under a map path ("" is the top), for "valid keys are ..." messages.
 std::vector<std::string> child_keys(const std::string& path);
+
+/// The library settings that a scenario key sets, as the library's messages name them
+/// ("WorldSettings::step_s" is time.step_s).
+const std::vector<std::pair<std::string, std::string>>& library_settings_as_keys();
+/// A library message with each setting it names replaced by the scenario key that sets it.
+std::string in_scenario_keys(std::string message);
 
 }  // namespace dipper::scenario

@@ -5,6 +5,7 @@
 #include "core/state_io.h"
 #include "dem/output.h"
 #include "coupling/mixed_bed.h"
+#include "scenario/keys.h"
 #include "wear/calibration.h"
 #include "wear/wear_output.h"
 
@@ -283,7 +284,7 @@ public:
             }
         } catch (const SimulationError& e) {
             result.status = RunStatus::diverged;
-            result.message = e.what();
+            result.message = in_scenario_keys(e.what());
         }
         if (options_.progress) progress(start, first_step, terminal, true);
         if (sim_) {

@@ -618,8 +618,8 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     const MapReader coupling = top.map("coupling");
     const std::int64_t substeps = coupling.integer("substeps");
     if (substeps < 1 || substeps > 100) coupling.fail("substeps", concat(substeps), "a whole number of DEM steps per rigid step, 1 to 100");
-    s.coupling_substeps = static_cast<int>(substeps);
-    s.coupling_runaway_guard = coupling.boolean("runaway_guard");
+    s.coupling.substeps = static_cast<int>(substeps);
+    s.coupling.runaway_guard = coupling.boolean("runaway_guard");
     if (top.has("shovel")) s.shovel = read_shovel(s, top.map("shovel"));
     for (const MapReader& w : top.maps("wear")) {
         WearSpec spec;

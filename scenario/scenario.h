@@ -148,8 +148,7 @@ struct Scenario {
     std::vector<RegionProbe> regions;
     std::optional<ReposeProbe> repose;
     OutputSpec output;
-    int coupling_substeps = 5;
-    bool coupling_runaway_guard = false;  ///< coupling.runaway_guard (CouplingSettings::runaway_guard)
+    coupling::CouplingSettings coupling;  ///< coupling.substeps, coupling.runaway_guard
     std::optional<ShovelSpec> shovel;
     std::vector<WearSpec> wear;
 

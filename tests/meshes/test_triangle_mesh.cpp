@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
 #include <fstream>
 #include <random>
 
@@ -64,23 +65,24 @@ TEST_CASE("inside test and distance of a closed mesh", "[meshes][unit]")
 TEST_CASE("STL, OBJ and PLY files load into the same mesh", "[meshes][unit]")
 {
     const TriangleMesh box = make_box_mesh({0, 0, 0}, {1, 2, 3});
-    write_stl(box, "box_roundtrip.stl");
-    const TriangleMesh from_stl = load_triangle_mesh("box_roundtrip.stl");
+    const std::filesystem::path dir = std::filesystem::temp_directory_path();
+    write_stl(box, (dir / "dipper_box_roundtrip.stl").string());
+    const TriangleMesh from_stl = load_triangle_mesh((dir / "dipper_box_roundtrip.stl").string());
     CHECK(from_stl.triangle_count() == 12);
     CHECK(from_stl.vertex_count() == 8);  // identical vertices merged, so edges are shared
     CHECK(from_stl.edge_count() == 18);
     CHECK(from_stl.total_area_m2() == Approx(box.total_area_m2()).epsilon(1e-12));
 
     {
-        std::ofstream obj("square.obj");
+        std::ofstream obj(dir / "dipper_square.obj");
         obj << "v 0 0 0\nv 1000 0 0\nv 1000 1000 0\nv 0 1000 0\nf 1 2 3\nf 1 3 4\n";
-        std::ofstream ply("square.ply");
+        std::ofstream ply(dir / "dipper_square.ply");
         ply << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
                "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
                "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
     }
-    const TriangleMesh from_obj = load_triangle_mesh("square.obj", 0.001);  // file in millimetres
-    const TriangleMesh from_ply = load_triangle_mesh("square.ply");
+    const TriangleMesh from_obj = load_triangle_mesh((dir / "dipper_square.obj").string(), 0.001);  // file in millimetres
+    const TriangleMesh from_ply = load_triangle_mesh((dir / "dipper_square.ply").string());
     CHECK(from_obj.total_area_m2() == Approx(1.0).epsilon(1e-12));
     CHECK(from_ply.total_area_m2() == Approx(1.0).epsilon(1e-12));
     CHECK(from_obj.edge_count() == 5);

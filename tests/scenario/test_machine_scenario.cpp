@@ -83,9 +83,9 @@ TEST_CASE("shovel, rock and wear keys: values, defaults and errors that name the
     CHECK(s.shovel->start_s == 1.5);
     CHECK(s.shovel->motion == "default_cycle");
     CHECK(s.shovel->bulk_density_kg_per_m3 == 1903.0);
-    CHECK(s.coupling_substeps == 3);
-    CHECK(s.coupling_runaway_guard);
-    CHECK_FALSE(parse_scenario(base(""), "case.yaml", ".").coupling_runaway_guard);  // off unless asked for
+    CHECK(s.coupling.substeps == 3);
+    CHECK(s.coupling.runaway_guard);
+    CHECK_FALSE(parse_scenario(base(""), "case.yaml", ".").coupling.runaway_guard);  // off unless asked for
     REQUIRE(s.wear.size() == 1);
     CHECK(s.wear[0].law == "force_work");
     CHECK(s.wear[0].smoothing_iterations == 2);
@@ -602,7 +602,7 @@ TEST_CASE("a rock whose centre is inside the dipper's steel stops the run with a
     const Vec3 centre = o + r * Vec3{2.0, 0.0, -0.05};
     scene.coupled().add_rock(cube, 3000.0, scene.rigid().material_index("rock"), dem->materials().index_of("rock"), centre);
     CHECK_THROWS_WITH(scene.check_tunnelling(), Catch::Contains("rock 0 (") && Catch::Contains("inside plate 0 of the dipper") &&
-                                                    Catch::Contains("went through the steel") && Catch::Contains("Reduce time.step_s"));
+                                                    Catch::Contains("went through the steel") && Catch::Contains("Reduce WorldSettings::step_s") && Catch::Contains("CouplingSettings::substeps (now 5)"));
 }
 
 TEST_CASE("among many rocks on two threads, the first rock in order inside the steel is the one named", "[scenario][shovel]")

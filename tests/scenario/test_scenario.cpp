@@ -270,6 +270,20 @@ TEST_CASE("docs/scenario.md lists exactly the keys the parser reads, with their 
     }
 }
 
+TEST_CASE("library messages reach the user with the scenario keys of the settings they name", "[scenario][unit]")
+{
+    // every setting the library names is set by a key that exists, and the message names that key instead
+    for (const auto& [setting, key] : library_settings_as_keys()) {
+        INFO(setting << " -> " << key);
+        CHECK(find_key(key) != nullptr);
+        const std::string m = in_scenario_keys("reduce " + setting + " or " + setting + ".");
+        CHECK(m == "reduce " + key + " or " + key + ".");
+    }
+    CHECK(in_scenario_keys("the runaway guard (CouplingSettings::runaway_guard) or fewer DEM steps per rigid-body step "
+                           "(CouplingSettings::substeps); reduce WorldSettings::step_s") ==
+          "the runaway guard (coupling.runaway_guard) or fewer DEM steps per rigid-body step (coupling.substeps); reduce time.step_s");
+}
+
 TEST_CASE("a run stopped at a checkpoint and resumed ends bit for bit as the uninterrupted run", "[scenario]")
 {
     const fs::path base = fs::temp_directory_path() / "dipper_test_resume";
@@ -380,7 +394,7 @@ TEST_CASE("a diverging run stops with a diagnosis and keeps what it wrote", "[sc
     REQUIRE(r.status == RunStatus::diverged);
     CHECK(exit_code(r) == 3);
     CHECK_THAT(r.message, Catch::Contains("step ") && Catch::Contains("particle") && Catch::Contains("overlap") &&
-                              Catch::Contains("of the smaller radius (limit 0.5)") && Catch::Contains("reduce step_s, e.g. to"));
+                              Catch::Contains("of the smaller radius (limit 0.5)") && Catch::Contains("reduce time.step_s, e.g. to"));
     CHECK(summary_value(dir.string(), "status") == "diverged");
     CHECK(read_file((dir / "summary.json").string()).find("nan") == std::string::npos);  // JSON has no NaN: null
     CHECK(fs::exists(dir / "particles_000000.vtp"));
