@@ -501,6 +501,17 @@ std::vector<std::pair<std::string, double>> CoSimulation::wear_by_region(const W
     return v;
 }
 
+std::vector<std::string> CoSimulation::plate_names(const WearPart& w) const
+{
+    if (w.part == "door") return std::vector<std::string>(dipper_.door.plates.size(), "door");
+    if (w.part != "dipper") return {};
+    std::vector<std::string> names{"bottom", "lip", "side_minus_y", "side_plus_y", "top"};
+    const auto teeth = static_cast<std::size_t>(dipper_.parameters.tooth_count);
+    for (std::size_t k = 0; k < teeth; ++k) names.push_back(concat("tooth_", k + 1));
+    for (std::size_t k = names.size(); k < dipper_.body.plates.size(); ++k) names.push_back(concat("bar_", k - 4 - teeth));
+    return names;
+}
+
 void CoSimulation::wear_pose(const WearPart& w, Mat3& rotation, Vec3& origin_m) const
 {
     if (w.body >= 0 && rigid_->is_dynamic(w.body)) {

@@ -151,6 +151,9 @@ public:
     /// The dipper's wear volume by part of it (bottom, lip, sides, top, teeth, bars), m^3; empty for other
     /// parts.
     std::vector<std::pair<std::string, double>> wear_by_region(const WearPart& w) const;
+    /// The names of the plates of the dipper or the door, indexed as meshes::MachinePart::triangle_plate: bottom,
+    /// lip, side_minus_y, side_plus_y, top, tooth_1 .., bar_1 ..; door. Empty for other parts.
+    std::vector<std::string> plate_names(const WearPart& w) const;
     /// Pose of a wear surface's mesh frame in the world now.
     void wear_pose(const WearPart& w, Mat3& rotation, Vec3& origin_m) const;
 

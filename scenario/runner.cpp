@@ -6,6 +6,7 @@
 #include "dem/output.h"
 #include "coupling/mixed_bed.h"
 #include "scenario/keys.h"
+#include "scenario/simulation.h"
 #include "wear/calibration.h"
 #include "wear/wear_output.h"
 
@@ -119,25 +120,11 @@ public:
             copy << scenario_.text;
             finish_writing(copy, dir_ + "/scenario.yaml");
         }
-        build(build_world(scenario_));
-        if (!scenario_.pile.empty()) {  // errors name file and line
-            const coupling::CoSimulation& sim = *sim_;
-            pile_ = coupling::load_state(sim_->coupled(), scenario_.pile,
-                                         [&sim](const Vec3& c, double r) { return sim.clear_of_machine(c, r); });
-            if (options_.progress && (pile_.spheres_left_out > 0 || pile_.rocks_left_out > 0))
-                std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
-                             scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);
-        }
-        require_run_fits(scenario_, *world_);  // before the fills claim the memory
-        build_particles(scenario_, *world_);
-        if (sim_) {
-            fill_rocks(scenario_, *sim_);
-            add_wear(scenario_, *sim_);
-        }
-        pourers_ = make_pourers(scenario_, *world_);
-        for (dem::Pourer& p : pourers_) p.update(*world_);
-        require_spheres_at_start(scenario_, *world_);
-        world_->prepare();
+        adopt(std::make_unique<Simulation>(scenario_));
+        pile_ = model_->pile();
+        if (options_.progress && (pile_.spheres_left_out > 0 || pile_.rocks_left_out > 0))
+            std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
+                         scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);
         open_outputs(false, 0);
         write_row();
         write_snapshot();
@@ -150,17 +137,7 @@ public:
     /// Continues from a checkpoint written by checkpoint().
     void start_from(StateReader& in)
     {
-        build(build_world(scenario_));
-        if (sim_) {
-            // the bodies in the order of the run: walls and shovel, the rocks, then the wear surfaces
-            sim_->coupled().read_rocks(in);
-            add_wear(scenario_, *sim_);
-        }
-        pourers_ = make_pourers(scenario_, *world_);
-        world_->read_state(in);
-        if (sim_) sim_->read_state(in);
-        in.tag("pours");
-        for (dem::Pourer& p : pourers_) p.read_state(in);
+        adopt(std::make_unique<Simulation>(scenario_, 0, in));
         in.tag("outputs");
         next_csv_s_ = in.value<double>();
         next_vtk_s_ = in.value<double>();
@@ -182,7 +159,6 @@ public:
             }
         }
         in.finish();
-        require_run_fits(scenario_, *world_);  // the scenario inside a checkpoint is checked as a file is
         open_outputs(true, csv_bytes);
         std::size_t k = 0;
         particles_pvd_->restore(entries[k++]);
@@ -208,7 +184,7 @@ public:
         const double dt = world_->step_s();
         RunResult result;
         // the run ends at the first step that reaches duration_s (within a millionth of a step)
-        const auto reached = [&](double t) { return world_->time_s() >= t - 1e-6 * dt; };
+        const auto reached = [&](double t) { return model_->reached(t); };
         // a shovel run may end after a number of passes: 1 s after the last one's door opened
         const std::size_t passes = scenario_.shovel ? static_cast<std::size_t>(scenario_.shovel->passes) : 0;
         const auto end_after_passes = [&] {
@@ -225,27 +201,10 @@ public:
             throw InputError(concat("--stop-after ", options_.stop_after_s, " s: the run is already at t = ", world_->time_s(),
                                     " s; give a later time"));
         require_reasonable_step_count(end_s - world_->time_s(), dt);
-        // walls taken out at their removed_at_s (build_world adds the planes, then the meshes, first)
-        const auto remove_walls_due = [&] {
-            for (std::size_t k = 0; k < scenario_.planes.size() + scenario_.meshes.size(); ++k) {
-                const bool plane = k < scenario_.planes.size();
-                const double at = plane ? scenario_.planes[k].removed_at_s : scenario_.meshes[k - scenario_.planes.size()].removed_at_s;
-                const int id = static_cast<int>(k);
-                if (std::isfinite(at) && !world_->wall_removed(id) && reached(at)) world_->remove_wall(id);
-            }
-        };
         try {
             while (!reached(end_s)) {
-                remove_walls_due();
-                const std::uint64_t before = world_->step_count();
-                if (sim_) {
-                    sim_->step();
-                    end_after_passes();
-                } else {
-                    world_->step();
-                }
-                if (world_->step_count() / kPourEvery != before / kPourEvery)
-                    for (dem::Pourer& p : pourers_) p.update(*world_);
+                model_->step();
+                if (sim_) end_after_passes();
                 // each schedule moves past now; an interval too short to move it is refused before the run
                 const auto advance = [&](double& next, double interval) {
                     for (int k = 0; reached(next); ++k) {
@@ -268,11 +227,13 @@ public:
                     checkpoint();
                 }
                 if (options_.progress) progress(start, first_step, terminal, false);
-                if (g_signal != 0 || (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))) {
+                const bool caller_stops = options_.on_step && !options_.on_step(world_->time_s(), world_->step_count()) && !reached(end_s);
+                if (g_signal != 0 || caller_stops || (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))) {
                     checkpoint();
                     result.status = RunStatus::interrupted;
                     result.message = g_signal != 0 ? concat("stopped by signal ", static_cast<int>(g_signal))
-                                                   : concat("stopped at t = ", world_->time_s(), " s as asked");
+                                     : caller_stops ? concat("stopped by the caller at t = ", world_->time_s(), " s")
+                                                    : concat("stopped at t = ", world_->time_s(), " s as asked");
                     break;
                 }
             }
@@ -308,14 +269,12 @@ public:
     }
 
 private:
-    static constexpr std::uint64_t kPourEvery = 20;  ///< steps between pour insertions
-
-    /// Takes the scenario's DEM world; a run with rocks, the shovel, wear or a pile hands it to a co-simulation.
-    void build(std::unique_ptr<dem::World> world)
+    /// The model the run steps; world_ and sim_ point into it.
+    void adopt(std::unique_ptr<Simulation> model)
     {
-        world_ = world.get();
-        if (scenario_.uses_coupling()) sim_ = build_co_simulation(scenario_, std::move(world));
-        else own_world_ = std::move(world);
+        model_ = std::move(model);
+        world_ = &model_->world();
+        sim_ = model_->co_simulation();
     }
 
     /// The walls that outputs list: all of them, less the hulls of rocks.
@@ -544,11 +503,7 @@ private:
         out.text(scenario_.source);
         out.text(scenario_.base_dir);
         out.value<std::int32_t>(world_->threads());
-        if (sim_) sim_->coupled().write_rocks(out);
-        world_->write_state(out);
-        if (sim_) sim_->write_state(out);
-        out.tag("pours");
-        for (const dem::Pourer& p : pourers_) p.write_state(out);
+        model_->write_state(out);
         out.tag("outputs");
         out.value(next_csv_s_);
         out.value(next_vtk_s_);
@@ -782,9 +737,9 @@ private:
     Scenario scenario_;
     std::string dir_;
     RunOptions options_;
-    dem::World* world_ = nullptr;              ///< the run's DEM world: own_world_'s or sim_'s
-    std::unique_ptr<dem::World> own_world_;    ///< spheres and walls only
-    std::unique_ptr<coupling::CoSimulation> sim_;  ///< rocks, shovel and wear; null for spheres and walls only
+    std::unique_ptr<Simulation> model_;
+    dem::World* world_ = nullptr;             ///< model_'s DEM world
+    coupling::CoSimulation* sim_ = nullptr;   ///< model_'s co-simulation: rocks, shovel and wear; null for spheres and walls only
     std::vector<wear::CalibrationResult> calibrations_;  ///< per wear surface, at the end (scale 0: none)
     std::string calibration_error_;  ///< why a finished run's wear could not be calibrated (after the summary)
     struct SectionResult {
@@ -794,7 +749,6 @@ private:
     };
     std::vector<std::vector<SectionResult>> sections_;  ///< per wear surface, at the end
     std::vector<int> walls_;             ///< the walls outputs list
-    std::vector<dem::Pourer> pourers_;
     std::unique_ptr<dem::PvdCollection> particles_pvd_;
     std::vector<std::unique_ptr<dem::PvdCollection>> wall_pvd_;
     std::unique_ptr<dem::PvdCollection> rocks_pvd_;
@@ -836,7 +790,16 @@ RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, con
     return run.loop();
 }
 
-RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)
+namespace {
+
+/// A checkpoint opened and its run header read: the reader stands at the model's state.
+struct OpenCheckpoint {
+    std::unique_ptr<StateReader> in;
+    Scenario scenario;
+    int threads = 1;
+};
+
+OpenCheckpoint open_checkpoint(const std::string& out_dir, const std::string& checkpoint_file)
 {
     const fs::path dir(out_dir);
     const std::string path = checkpoint_file.empty() ? (dir / "checkpoint.bin").string() : checkpoint_file;
@@ -850,25 +813,40 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
                                                                                    : (dir / "checkpoint.prev.bin").string());
         throw InputError(concat("no checkpoint '", path, "' to resume from", hint));
     }
-    std::unique_ptr<StateReader> in;
+    OpenCheckpoint c;
     try {
-        in = std::make_unique<StateReader>(path, kCheckpointMagic);
+        c.in = std::make_unique<StateReader>(path, kCheckpointMagic);
     } catch (const InputError& e) {
         const bool prev = checkpoint_file.empty() && fs::exists(dir / "checkpoint.prev.bin");
         throw InputError(concat(e.what(), prev ? concat("; the previous checkpoint is kept: dipper resume ", out_dir, " --from ",
                                                           (dir / "checkpoint.prev.bin").string())
                                                : std::string()));
     }
-    in->tag("run");
-    const std::string text = in->text(), source = in->text(), base_dir = in->text();
-    const int threads = in->value<std::int32_t>();
-    if (threads < 1 || threads > 1024) in->fail(concat("a thread count of ", threads, "; expected 1 to 1024"));
-    Scenario scenario = parse_scenario(text, source, base_dir);
+    StateReader& in = *c.in;
+    in.tag("run");
+    const std::string text = in.text(), source = in.text(), base_dir = in.text();
+    c.threads = in.value<std::int32_t>();
+    if (c.threads < 1 || c.threads > 1024) in.fail(concat("a thread count of ", c.threads, "; expected 1 to 1024"));
+    c.scenario = parse_scenario(text, source, base_dir);
+    return c;
+}
+
+}  // namespace
+
+RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)
+{
+    OpenCheckpoint c = open_checkpoint(out_dir, checkpoint_file);
     RunOptions o = options;
-    if (o.threads <= 0) o.threads = threads;  // same thread count, same bits
-    Run run(std::move(scenario), out_dir, o);
-    run.start_from(*in);
+    if (o.threads <= 0) o.threads = c.threads;  // same thread count, same bits
+    Run run(std::move(c.scenario), out_dir, o);
+    run.start_from(*c.in);
     return run.loop();
+}
+
+std::unique_ptr<Simulation> read_checkpoint(const std::string& out_dir, int threads, const std::string& checkpoint_file)
+{
+    OpenCheckpoint c = open_checkpoint(out_dir, checkpoint_file);
+    return std::make_unique<Simulation>(std::move(c.scenario), threads > 0 ? threads : c.threads, *c.in);
 }
 
 double progress_rate(double previous, double recent, double since_s, double elapsed_s)

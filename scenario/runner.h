@@ -4,7 +4,11 @@
 
 #include "scenario/run_limits.h"
 #include "scenario/scenario.h"
+#include "scenario/simulation.h"
 
+#include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 
 namespace dipper::scenario {
@@ -15,6 +19,9 @@ struct RunOptions {
     int threads = -1;         ///< > 0 replaces the scenario's threads (resume: the checkpoint's count)
     bool progress = true;     ///< progress lines on stderr
     double stop_after_s = 0;  ///< > 0: stop with a checkpoint once simulated time reaches this (tests, batch queues)
+    /// Called after every step with the simulated time and the step count; false stops the run with a checkpoint
+    /// as SIGINT does (a front end's progress display and stop button).
+    std::function<bool(double time_s, std::uint64_t steps)> on_step;
 };
 
 struct RunResult {
@@ -28,6 +35,9 @@ struct RunResult {
 RunResult run_scenario(const Scenario& scenario, const std::string& out_dir, const RunOptions& options);
 /// Continues the run in out_dir from its checkpoint (out_dir/checkpoint.bin, or `checkpoint_file` if given).
 RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file = "");
+/// The model of a run's checkpoint (out_dir/checkpoint.bin, or `checkpoint_file`) as it was saved, to read or step
+/// on without the run's files; on `threads` (> 0) or the checkpoint's own count.
+std::unique_ptr<Simulation> read_checkpoint(const std::string& out_dir, int threads = 0, const std::string& checkpoint_file = "");
 
 /// FNV-1a hash of every particle's position, velocity and spin in id order: equal hashes, equal states.
 std::uint64_t particle_state_hash(const dem::World& world);

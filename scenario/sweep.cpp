@@ -95,34 +95,35 @@ std::vector<std::vector<std::string>> Sweep::variants() const
     return out;
 }
 
-Scenario Sweep::variant_scenario(std::size_t index) const
+std::string with_values(const std::string& text, const std::vector<KeyValue>& values, const std::string& text_source)
 {
-    const auto all = variants();
-    DIPPER_ASSERT(index < all.size(), "variant index out of range");
-    YAML::Node root = YAML::Load(base_text);
-    for (std::size_t k = 0; k < parameters.size(); ++k) {
-        const KeyPath path = split_key(parameters[k].key, concat(source, ": parameters[", k, "]: "));
+    YAML::Node root = YAML::Load(text);
+    for (const KeyValue& kv : values) {
+        const KeyPath path = split_key(kv.key, kv.where);
+        const std::string key = concat(kv.where, "key '", kv.key, "': ");
         YAML::Node node = root;
         for (std::size_t s = 0; s < path.names.size(); ++s) {
             const bool last = s + 1 == path.names.size() && path.indices[s] < 0;
-            if (!node.IsMap()) throw InputError(concat(source, ": key '", parameters[k].key, "': '", path.names[s], "' is not inside a map in ", base_source));
+            if (!node.IsMap()) throw InputError(concat(key, "'", path.names[s], "' is not inside a map in ", text_source));
             if (last) {
-                node[path.names[s]] = YAML::Load(all[index][k]);
+                try {
+                    node[path.names[s]] = YAML::Load(kv.value);
+                } catch (const YAML::Exception& e) {
+                    throw InputError(concat(key, "got '", kv.value, "'; expected a YAML value (", e.msg, ")"));
+                }
                 break;
             }
             if (!node[path.names[s]] || node[path.names[s]].IsNull()) {
-                if (path.indices[s] >= 0)
-                    throw InputError(concat(source, ": key '", parameters[k].key, "': ", base_source, " has no list '", path.names[s], "'"));
-                node[path.names[s]] = YAML::Node(YAML::NodeType::Map);  // a map the base leaves to its defaults
+                if (path.indices[s] >= 0) throw InputError(concat(key, text_source, " has no list '", path.names[s], "'"));
+                node[path.names[s]] = YAML::Node(YAML::NodeType::Map);  // a map the text leaves to its defaults
             }
             YAML::Node child(node[path.names[s]]);
             if (path.indices[s] >= 0) {
                 if (!child.IsSequence() || static_cast<std::size_t>(path.indices[s]) >= child.size())
-                    throw InputError(concat(source, ": key '", parameters[k].key, "': ", base_source, " has no item ", path.indices[s],
-                                            " in '", path.names[s], "'"));
+                    throw InputError(concat(key, text_source, " has no item ", path.indices[s], " in '", path.names[s], "'"));
                 const YAML::Node item = child[static_cast<std::size_t>(path.indices[s])];
                 child.reset(item);  // alias, not assignment: assignment would overwrite the list
-                if (s + 1 == path.names.size()) throw InputError(concat(source, ": key '", parameters[k].key, "' names a list item, not a value"));
+                if (s + 1 == path.names.size()) throw InputError(concat(key, "names a list item, not a value"));
             }
             node.reset(child);
         }
@@ -130,9 +131,19 @@ Scenario Sweep::variant_scenario(std::size_t index) const
     YAML::Emitter e;
     e.SetDoublePrecision(17);
     e << root;
-    std::string text = e.c_str();
-    text += "\n";
-    return parse_scenario(text, concat(base_source, " (variant ", index, " of ", source, ")"), base_dir);
+    std::string out = e.c_str();
+    out += "\n";
+    return out;
+}
+
+Scenario Sweep::variant_scenario(std::size_t index) const
+{
+    const auto all = variants();
+    DIPPER_ASSERT(index < all.size(), "variant index out of range");
+    std::vector<KeyValue> values;
+    for (std::size_t k = 0; k < parameters.size(); ++k)
+        values.push_back({parameters[k].key, all[index][k], concat(source, ": parameters[", k, "]: ")});
+    return parse_scenario(with_values(base_text, values, base_source), concat(base_source, " (variant ", index, " of ", source, ")"), base_dir);
 }
 
 Sweep load_sweep(const std::string& path)

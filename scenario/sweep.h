@@ -17,6 +17,17 @@ struct SweepParameter {
     std::vector<std::string> values;
 };
 
+/// A key set to a value, as a sweep's variant or a script sets it: `key` a path such as `shovel.rake_angle_deg` or
+/// `meshes[0].motion.velocity_m_per_s`, `value` YAML text, `where` what messages about it begin with.
+struct KeyValue {
+    std::string key, value, where;
+};
+
+/// The scenario text with each key set to its value (keys the text leaves out are added, maps included); an
+/// InputError names the key if it is no scenario key or the text has no such list item. `text_source` names
+/// the text in messages. The result is parsed as any scenario text is.
+std::string with_values(const std::string& text, const std::vector<KeyValue>& values, const std::string& text_source);
+
 struct Sweep {
     std::string source;
     std::string base_text, base_source, base_dir;  ///< the base scenario file

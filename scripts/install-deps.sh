@@ -16,6 +16,8 @@ packages=(
   libbenchmark-dev     # micro-benchmarks
   libomp-dev           # OpenMP runtime headers for clang users; g++ ships libgomp
   python3 python3-vtk9 # tests read our VTK output with the real VTK reader
+  python3-dev pybind11-dev python3-numpy  # the Python module dipper
+  python3-pytest python3-yaml python3-pandas  # its tests; scenarios from dicts; tables as DataFrames
 )
 
 missing=()

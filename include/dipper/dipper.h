@@ -42,4 +42,5 @@
 // scenario: scenario files, runs and sweeps
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/simulation.h"
 #include "scenario/sweep.h"

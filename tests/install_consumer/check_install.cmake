@@ -17,3 +17,12 @@ execute_process(COMMAND ${WORK_DIR}/build/consumer RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the consumer ran but a result was wrong (sphere, rock or wear)")
 endif()
+# The Python module from the installed prefix alone: imported, a scenario loaded and stepped
+if(PYTHON)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${WORK_DIR}/prefix/${PYTHON_DIR} ${PYTHON} -c
+                          "import dipper, sys; assert dipper.__file__.startswith('${WORK_DIR}/prefix'), dipper.__file__; s = dipper.load('${SOURCE_DIR}/tests/data/scenarios/kill_resume.yaml'); m = dipper.Simulation(s, threads=1); m.step(3); assert m.step_count == 3; print('installed module:', dipper.__file__)"
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the installed Python module could not be imported or stepped")
+  endif()
+endif()

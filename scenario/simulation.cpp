@@ -1,0 +1,91 @@
+#include "scenario/simulation.h"
+
+#include "scenario/run_limits.h"
+
+#include <cmath>
+
+namespace dipper::scenario {
+
+Simulation::Simulation(Scenario scenario, int threads) : scenario_(std::move(scenario))
+{
+    if (threads > 0) scenario_.threads = threads;
+    build();
+    if (!scenario_.pile.empty()) {  // errors name file and line
+        const coupling::CoSimulation& sim = *sim_;
+        pile_ = coupling::load_state(sim_->coupled(), scenario_.pile, [&sim](const Vec3& c, double r) { return sim.clear_of_machine(c, r); });
+    }
+    require_run_fits(scenario_, *world_);  // before the fills claim the memory
+    build_particles(scenario_, *world_);
+    if (sim_) {
+        fill_rocks(scenario_, *sim_);
+        add_wear(scenario_, *sim_);
+    }
+    pourers_ = make_pourers(scenario_, *world_);
+    for (dem::Pourer& p : pourers_) p.update(*world_);
+    require_spheres_at_start(scenario_, *world_);
+    world_->prepare();
+}
+
+Simulation::Simulation(Scenario scenario, int threads, StateReader& in) : scenario_(std::move(scenario))
+{
+    if (threads > 0) scenario_.threads = threads;
+    build();
+    if (sim_) {
+        // the bodies in the order of the run: walls and shovel, the rocks, then the wear surfaces
+        sim_->coupled().read_rocks(in);
+        add_wear(scenario_, *sim_);
+    }
+    pourers_ = make_pourers(scenario_, *world_);
+    world_->read_state(in);
+    if (sim_) sim_->read_state(in);
+    in.tag("pours");
+    for (dem::Pourer& p : pourers_) p.read_state(in);
+    require_run_fits(scenario_, *world_);  // the scenario inside a checkpoint is checked as a file is
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::build()
+{
+    std::unique_ptr<dem::World> world = build_world(scenario_);
+    world_ = world.get();
+    if (scenario_.uses_coupling()) sim_ = build_co_simulation(scenario_, std::move(world));
+    else own_world_ = std::move(world);
+}
+
+void Simulation::write_state(StateWriter& out) const
+{
+    if (sim_) sim_->coupled().write_rocks(out);
+    world_->write_state(out);
+    if (sim_) sim_->write_state(out);
+    out.tag("pours");
+    for (const dem::Pourer& p : pourers_) p.write_state(out);
+}
+
+void Simulation::remove_walls_due()
+{
+    // build_world adds the planes, then the meshes, first
+    for (std::size_t k = 0; k < scenario_.planes.size() + scenario_.meshes.size(); ++k) {
+        const bool plane = k < scenario_.planes.size();
+        const double at = plane ? scenario_.planes[k].removed_at_s : scenario_.meshes[k - scenario_.planes.size()].removed_at_s;
+        const int id = static_cast<int>(k);
+        if (std::isfinite(at) && !world_->wall_removed(id) && reached(at)) world_->remove_wall(id);
+    }
+}
+
+void Simulation::step()
+{
+    remove_walls_due();
+    const std::uint64_t before = world_->step_count();
+    if (sim_) sim_->step();
+    else world_->step();
+    if (world_->step_count() / kPourEvery != before / kPourEvery)
+        for (dem::Pourer& p : pourers_) p.update(*world_);
+}
+
+void Simulation::run_until(double t_s)
+{
+    while (!reached(t_s)) step();
+}
+
+}  // namespace dipper::scenario
