@@ -13,18 +13,6 @@
 
 namespace dipper::dem {
 
-namespace {
-
-/// Contiguous block [begin, end) of n items for thread t of T: each thread's output stays in index
-/// order, so concatenating per-thread results gives the same sequence for any thread count.
-void thread_block(std::size_t n, int t, int threads, std::size_t& begin, std::size_t& end)
-{
-    begin = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
-    end = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
-}
-
-}  // namespace
-
 World::World(MaterialTable materials, WorldSettings settings) : materials_(std::move(materials)), settings_(settings)
 {
     const std::string at = "WorldSettings";
@@ -203,97 +191,6 @@ void World::sum_wall_reactions()
     }
 }
 
-// ---- time step -----------------------------------------------------------------------------------
-
-double World::reference_step_s() const
-{
-    const std::size_t i = step_setting_particle();
-    if (i >= particles_.size()) return std::numeric_limits<double>::infinity();
-    return std::sqrt(particles_.mass_kg[i] / stiffest_contact_N_per_m(i));
-}
-
-double World::stiffest_contact_N_per_m(std::size_t i) const
-{
-    return stiffest_contact_N_per_m(particles_.radius_m[i], particles_.material[i]);
-}
-
-double World::stiffest_contact_N_per_m(double radius_m, MaterialIndex a) const
-{
-    // The stiffest contact a particle can have is against a wall (eq. 4 with r2 -> inf): k_i r_i C,
-    // with C the largest C_norm of any pair its material has. A sphere pair has m* K <= m_i k_i r_i C.
-    double max_scale = 0.0;
-    for (std::size_t b = 0; b < materials_.size(); ++b)
-        if (materials_.has_pair(a, static_cast<MaterialIndex>(b)))
-            max_scale = std::max(max_scale, materials_.pair_unchecked(a, static_cast<MaterialIndex>(b)).normal_stiffness_scale);
-    return materials_.material(a).bulk_modulus_Pa() * radius_m * max_scale;
-}
-
-double World::default_step_s(double radius_m, MaterialIndex material) const
-{
-    const double k = stiffest_contact_N_per_m(radius_m, material);
-    if (!(k > 0.0)) return std::numeric_limits<double>::infinity();
-    return kDefaultStepFactor * std::sqrt(sphere_mass_kg(radius_m, materials_.material(material).density_kg_per_m3) / k);
-}
-
-std::size_t World::step_setting_particle() const
-{
-    std::vector<double> max_scale(materials_.size(), 0.0);
-    for (std::size_t a = 0; a < materials_.size(); ++a)
-        for (std::size_t b = 0; b < materials_.size(); ++b)
-            if (materials_.has_pair(static_cast<MaterialIndex>(a), static_cast<MaterialIndex>(b)))
-                max_scale[a] = std::max(max_scale[a], materials_.pair_unchecked(static_cast<MaterialIndex>(a),
-                                                                                static_cast<MaterialIndex>(b))
-                                                          .normal_stiffness_scale);
-    double best = std::numeric_limits<double>::infinity();
-    std::size_t best_i = particles_.size();
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
-        const MaterialIndex a = particles_.material[i];
-        const double k = materials_.material(a).bulk_modulus_Pa() * particles_.radius_m[i] * max_scale[a];
-        if (k > 0.0 && std::sqrt(particles_.mass_kg[i] / k) < best) {
-            best = std::sqrt(particles_.mass_kg[i] / k);
-            best_i = i;
-        }
-    }
-    return best_i;
-}
-
-double World::step_s() const
-{
-    // resolved by validate_step, which runs again after any particle, wall or material is added (the
-    // default is a minimum over the particles: at full size 146,000 square roots per call)
-    if (step_checked_) return step_s_;
-    if (settings_.step_s > 0.0) return settings_.step_s;
-    return kDefaultStepFactor * reference_step_s();
-}
-
-void World::validate_step()
-{
-    // every material pair that can meet must have coefficients
-    std::vector<bool> present(materials_.size(), false);
-    for (MaterialIndex m : particles_.material) present[m] = true;
-    for (std::size_t a = 0; a < materials_.size(); ++a) {
-        if (!present[a]) continue;
-        for (std::size_t b = 0; b < materials_.size(); ++b)
-            if (present[b]) materials_.pair(static_cast<MaterialIndex>(a), static_cast<MaterialIndex>(b));
-        for (const PlaneWall& p : planes_) materials_.pair(static_cast<MaterialIndex>(a), p.material);
-        for (const MeshWall& m : meshes_) materials_.pair(static_cast<MaterialIndex>(a), m.material());
-    }
-
-    const double reference = reference_step_s();
-    const double limit = kStableStepFactor * reference;
-    if (settings_.step_s > 0.0) {
-        if (settings_.step_s > limit)
-            throw InputError(concat("step_s = ", settings_.step_s, " s exceeds the stable limit ", limit, " s (",
-                                    kStableStepFactor, " x sqrt(m/K) = ", kStableStepFactor, " x ", reference,
-                                    " s for the smallest, stiffest particle); use step_s <= ", limit,
-                                    " s or leave it 0 for the default ", kDefaultStepFactor * reference, " s"));
-        step_s_ = settings_.step_s;
-    } else {
-        step_s_ = std::isfinite(reference) ? kDefaultStepFactor * reference : 0.0;
-    }
-    step_checked_ = true;
-}
-
 // ---- stepping ------------------------------------------------------------------------------------
 
 void World::prepare()
@@ -323,7 +220,7 @@ double seconds_since(std::chrono::steady_clock::time_point& mark)
 void World::evaluate_forces(double dt_s, double half_kick_s)
 {
     auto mark = std::chrono::steady_clock::now();
-    compute_pair_forces(dt_s);
+    max_overlap_ratio_ = pairs_.compute_forces(particles_, stiffness_radius_N_per_m_, materials_, dt_s, threads_);
     phase_seconds_.pair_forces += seconds_since(mark);
     compute_wall_contacts(dt_s);
     phase_seconds_.wall_forces += seconds_since(mark);
@@ -362,7 +259,7 @@ void World::run_steps(std::uint64_t n, const StepHooks& hooks)
         phase_seconds_.neighbour_search += seconds_since(mark);
 
         // forces: sphere pairs into per-thread arrays, wall contacts per particle
-        compute_pair_forces(dt);
+        max_overlap_ratio_ = pairs_.compute_forces(particles_, stiffness_radius_N_per_m_, materials_, dt, threads_);
         phase_seconds_.pair_forces += seconds_since(mark);
         compute_wall_contacts(dt);
         phase_seconds_.wall_forces += seconds_since(mark);
@@ -525,8 +422,11 @@ void World::rebuild()
             hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
         }
     }
-    double cell = std::max(2.0 * r_max + skin_m_, 1e-12);
-    int dims[3];
+    CellGrid grid;
+    grid.lo = lo;
+    double& cell = grid.cell;
+    cell = std::max(2.0 * r_max + skin_m_, 1e-12);
+    int* dims = grid.dims;
     const std::size_t max_cells = std::max<std::size_t>(64, 4 * n);
     for (;;) {
         // counted in doubles: a particle thrown far away must not overflow the cell count
@@ -537,16 +437,13 @@ void World::rebuild()
     }
     for (int a = 0; a < 3; ++a) dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
     const std::size_t cell_count = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
-    auto cell_of = [&](const Vec3& p) {
-        int c[3];
-        for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - lo[a]) / cell), 0, dims[a] - 1);
-        return static_cast<std::uint32_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
-    };
 
     // sort particles by cell (counting sort, stable) for memory locality
-    std::vector<std::uint32_t> particle_cell(n), cell_start(cell_count + 1, 0), order(n), old_to_new(n);
+    std::vector<std::uint32_t>& cell_start = grid.cell_start;
+    cell_start.assign(cell_count + 1, 0);
+    std::vector<std::uint32_t> particle_cell(n), order(n), old_to_new(n);
     for (std::size_t i = 0; i < n; ++i) {
-        particle_cell[i] = cell_of(particles_.position_m[i]);
+        particle_cell[i] = grid.cell_of(particles_.position_m[i]);
         ++cell_start[particle_cell[i] + 1];
     }
     std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
@@ -560,90 +457,7 @@ void World::rebuild()
     for (std::size_t i = 0; i < n; ++i)
         stiffness_radius_N_per_m_[i] = bulk_modulus_Pa_[particles_.material[i]] * particles_.radius_m[i];
 
-    // carry the history of touching pairs over, renumbered and oriented so that i < j
-    struct Carried { std::uint32_t i, j; ContactHistory history; std::uint8_t touching; };
-    std::vector<Carried> carried;
-    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
-        if (!pair_touching_[k]) continue;
-        if (pair_i_[k] >= n || pair_j_[k] >= n) continue;
-        std::uint32_t a = old_to_new[pair_i_[k]], b = old_to_new[pair_j_[k]];
-        ContactHistory h = pair_history_[k];
-        if (a > b) {  // seen from the other particle: both springs change sign
-            std::swap(a, b);
-            h.tangential_spring_m = -h.tangential_spring_m;
-            h.rolling_torque_N_m = -h.rolling_torque_N_m;
-        }
-        carried.push_back({a, b, h, 1});
-    }
-    std::sort(carried.begin(), carried.end(),
-              [](const Carried& p, const Carried& q) { return p.i != q.i ? p.i < q.i : p.j < q.j; });
-
-    // new half list: j > i within range r_i + r_j + skin, cells visited in increasing index so j ascends
-    std::vector<std::vector<std::uint32_t>> thread_i(static_cast<std::size_t>(threads_)), thread_j(thread_i.size());
-#pragma omp parallel num_threads(threads_)
-    {
-        const int t = omp_get_thread_num();
-        std::size_t begin, end;
-        thread_block(n, t, threads_, begin, end);
-        // filled as locals and moved in at the end: the vectors' headers share a cache line (as below)
-        std::vector<std::uint32_t> out_i, out_j;
-        for (std::size_t i = begin; i < end; ++i) {
-            const Vec3 xi = particles_.position_m[i];
-            const double ri = particles_.radius_m[i];
-            const std::uint32_t own = cell_of(xi);
-            const int cx = static_cast<int>(own % static_cast<std::uint32_t>(dims[0]));
-            const int cy = static_cast<int>((own / static_cast<std::uint32_t>(dims[0])) % static_cast<std::uint32_t>(dims[1]));
-            const int cz = static_cast<int>(own / (static_cast<std::uint32_t>(dims[0]) * static_cast<std::uint32_t>(dims[1])));
-            for (int dz = -1; dz <= 1; ++dz) {
-                const int z = cz + dz;
-                if (z < 0 || z >= dims[2]) continue;
-                for (int dy = -1; dy <= 1; ++dy) {
-                    const int y = cy + dy;
-                    if (y < 0 || y >= dims[1]) continue;
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xcell = cx + dx;
-                        if (xcell < 0 || xcell >= dims[0]) continue;
-                        const std::uint32_t c = static_cast<std::uint32_t>((static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + xcell);
-                        if (c < own) continue;
-                        for (std::uint32_t j = std::max<std::uint32_t>(cell_start[c], static_cast<std::uint32_t>(i + 1));
-                             j < cell_start[c + 1]; ++j) {
-                            const double range = ri + particles_.radius_m[j] + skin_m_;
-                            if (norm_squared(particles_.position_m[j] - xi) < range * range) {
-                                out_i.push_back(static_cast<std::uint32_t>(i));
-                                out_j.push_back(j);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        thread_i[static_cast<std::size_t>(t)] = std::move(out_i);
-        thread_j[static_cast<std::size_t>(t)] = std::move(out_j);
-    }
-    pair_i_.clear();
-    pair_j_.clear();
-    for (std::size_t t = 0; t < thread_i.size(); ++t) {
-        pair_i_.insert(pair_i_.end(), thread_i[t].begin(), thread_i[t].end());
-        pair_j_.insert(pair_j_.end(), thread_j[t].begin(), thread_j[t].end());
-    }
-    ++pair_list_version_;
-    const std::size_t pairs = pair_i_.size();
-    pair_history_.assign(pairs, ContactHistory{});
-    pair_touching_.assign(pairs, 0);
-
-    // merge the carried history into the new list (both sorted by (i, j))
-    {
-        std::size_t c = 0;
-        for (std::size_t k = 0; k < pairs && c < carried.size(); ++k) {
-            while (c < carried.size() && (carried[c].i < pair_i_[k] || (carried[c].i == pair_i_[k] && carried[c].j < pair_j_[k])))
-                ++c;  // a pair that drifted out of range has separated: its history ends
-            if (c < carried.size() && carried[c].i == pair_i_[k] && carried[c].j == pair_j_[k]) {
-                pair_history_[k] = carried[c].history;
-                pair_touching_[k] = 1;
-                ++c;
-            }
-        }
-    }
+    pairs_.rebuild(particles_, grid, skin_m_, old_to_new, threads_);
 
     // wall contacts keep their history (those on convex bodies too): renumbered and re-sorted by particle
     for (std::size_t k = 0; k < convex_pairs_.size(); ++k)
@@ -657,7 +471,7 @@ void World::rebuild()
 
     // planes and triangles near each particle, and the pairs of spheres and convex bodies, which take the
     // history of their contacts
-    build_wall_candidates(lo, cell, dims, cell_start);
+    build_wall_candidates(grid);
     split_convex_contacts();
 
     reference_position_m_ = particles_.position_m;
@@ -671,8 +485,12 @@ void World::rebuild()
     }
 }
 
-void World::build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start)
+void World::build_wall_candidates(const CellGrid& grid)
 {
+    const Vec3& lo = grid.lo;
+    const double cell = grid.cell;
+    const int* dims = grid.dims;
+    const std::vector<std::uint32_t>& cell_start = grid.cell_start;
     const std::size_t n = particles_.size();
     candidate_start_.assign(n + 1, 0);
     candidates_.clear();
@@ -982,135 +800,6 @@ std::vector<World::WallContact> World::merged_wall_contacts() const
 }
 
 // ---- forces --------------------------------------------------------------------------------------
-
-void World::compute_pair_forces(double dt_s)
-{
-    const std::size_t pairs = pair_i_.size();
-    const std::size_t n = particles_.size();
-    // raw pointers: the writes to the force arrays cannot alias the inputs
-    const Vec3* __restrict x = particles_.position_m.data();
-    const Vec3* __restrict v = particles_.velocity_m_per_s.data();
-    const Vec3* __restrict w = particles_.angular_velocity_rad_per_s.data();
-    const double* __restrict r = particles_.radius_m.data();
-    const double* __restrict m = particles_.mass_kg.data();
-    const MaterialIndex* __restrict mat = particles_.material.data();
-    const double* __restrict kr = stiffness_radius_N_per_m_.data();
-    const std::uint32_t* __restrict pi = pair_i_.data();
-    const std::uint32_t* __restrict pj = pair_j_.data();
-    std::uint8_t* __restrict touching = pair_touching_.data();
-    ContactHistory* __restrict history = pair_history_.data();
-    const MaterialTable& table = materials_;
-    double max_ratio = 0.0;
-    thread_force_N_.resize(static_cast<std::size_t>(threads_));
-    thread_torque_N_m_.resize(static_cast<std::size_t>(threads_));
-    const bool ranges_stale = touched_ranges_version_ != pair_list_version_ || thread_touched_.size() != static_cast<std::size_t>(threads_);
-    if (thread_touched_.size() != static_cast<std::size_t>(threads_)) thread_forces_clear_ = false;
-    thread_touched_.resize(static_cast<std::size_t>(threads_));
-    touched_ranges_version_ = pair_list_version_;
-
-    // Each thread takes a fixed block of pairs and adds both particles' shares into its own arrays; the
-    // gather adds the threads' arrays in thread order. Same thread count, same bits.
-#pragma omp parallel num_threads(threads_) reduction(max : max_ratio)
-    {
-        const int t = omp_get_thread_num();
-        std::size_t begin, end;
-        thread_block(pairs, t, threads_, begin, end);
-        // The thread's pairs touch only particles lo..hi-1 (particles are ordered by cell, so a block of pairs
-        // spans a block of particles): only that range of its arrays is cleared here and read by the gather.
-        // Found once per neighbour list.
-        if (ranges_stale) {
-            std::uint32_t lo = std::numeric_limits<std::uint32_t>::max(), hi = 0;
-            for (std::size_t k = begin; k < end; ++k) {
-                lo = std::min(lo, std::min(pi[k], pj[k]));
-                hi = std::max(hi, std::max(pi[k], pj[k]));
-            }
-            thread_touched_[static_cast<std::size_t>(t)] = begin < end ? ParticleRange{lo, hi + 1} : ParticleRange{0, 0};
-        }
-        auto& thread_force = thread_force_N_[static_cast<std::size_t>(t)];
-        auto& thread_torque = thread_torque_N_m_[static_cast<std::size_t>(t)];
-        if (thread_force.size() != n) thread_force.resize(n);
-        if (thread_torque.size() != n) thread_torque.resize(n);
-        Vec3* __restrict force = thread_force.data();
-        Vec3* __restrict torque = thread_torque.data();
-        // the gather leaves every element it reads at zero; only after an interrupted step are they cleared here
-        if (!thread_forces_clear_) {
-            std::fill(thread_force.begin(), thread_force.end(), Vec3{});
-            std::fill(thread_torque.begin(), thread_torque.end(), Vec3{});
-        }
-        double local_max = 0.0;
-        PairBatch batch;  // the touching pairs, gathered for the SIMD law and scattered after it
-
-        // forces of the gathered pairs into the thread's arrays, springs back into the pair history
-        auto flush = [&]() {
-            local_max = std::max(local_max, evaluate_pair_batch(batch, dt_s));
-            for (int c = 0; c < batch.count; ++c) {
-                const std::uint32_t i = batch.i[c], j = batch.j[c];
-                const Vec3 fi{batch.fx[c], batch.fy[c], batch.fz[c]};
-                force[i] += fi;
-                force[j] -= fi;
-                torque[i] += Vec3{batch.tix[c], batch.tiy[c], batch.tiz[c]};
-                torque[j] += Vec3{batch.tjx[c], batch.tjy[c], batch.tjz[c]};
-                history[batch.pair[c]] = {{batch.sx[c], batch.sy[c], batch.sz[c]}, {batch.mx[c], batch.my[c], batch.mz[c]}};
-            }
-            batch.count = 0;
-        };
-
-        ContactConstants memo;
-        double memo_share_i = 0.5;
-        double memo_ri = -1.0, memo_rj = -1.0, memo_mi = -1.0, memo_mj = -1.0;
-        MaterialIndex memo_a = 0, memo_b = 0;
-        for (std::size_t k = begin; k < end; ++k) {
-            const std::uint32_t i = pi[k], j = pj[k];
-            const Vec3 d = x[i] - x[j];
-            const double dist2 = norm_squared(d);
-            const double rsum = r[i] + r[j];
-            if (dist2 >= rsum * rsum) {
-                if (touching[k]) {  // separated: the history of this contact ends
-                    touching[k] = 0;
-                    history[k] = ContactHistory{};
-                }
-                continue;
-            }
-            touching[k] = 1;
-
-            // constants of the pair (eq. 4, 6, 8), recomputed only when the pair's kind changes: in a bed of
-            // one size and material they are computed once per thread and step
-            if (r[i] != memo_ri || r[j] != memo_rj || mat[i] != memo_a || mat[j] != memo_b || m[i] != memo_mi || m[j] != memo_mj) {
-                memo_ri = r[i]; memo_rj = r[j]; memo_a = mat[i]; memo_b = mat[j]; memo_mi = m[i]; memo_mj = m[j];
-                const double kr_sum = kr[i] + kr[j], m_sum = m[i] + m[j];
-                const PairCoefficients& p = table.pair_unchecked(mat[i], mat[j]);
-                memo = contact_constants(kr[i] * kr[j] / kr_sum * p.normal_stiffness_scale, m[i] * m[j] / m_sum,
-                                         r[i] * r[j] / rsum, p);
-                // The two springs k1 r1 and k2 r2 in series share the overlap in proportion to their
-                // compliances: the contact point lies half-way for equal spheres and on the surface of a much
-                // stiffer body (the wall limit).
-                memo_share_i = kr[j] / kr_sum;
-            }
-            const int c = batch.count++;
-            batch.pair[c] = static_cast<std::uint32_t>(k);
-            batch.i[c] = i;
-            batch.j[c] = j;
-            batch.dx[c] = d.x; batch.dy[c] = d.y; batch.dz[c] = d.z;
-            batch.distance2[c] = dist2;
-            batch.ri[c] = r[i];
-            batch.rj[c] = r[j];
-            batch.share_i[c] = memo_share_i;
-            const Vec3 dv = v[i] - v[j];
-            batch.dvx[c] = dv.x; batch.dvy[c] = dv.y; batch.dvz[c] = dv.z;
-            batch.wix[c] = w[i].x; batch.wiy[c] = w[i].y; batch.wiz[c] = w[i].z;
-            batch.wjx[c] = w[j].x; batch.wjy[c] = w[j].y; batch.wjz[c] = w[j].z;
-            batch.set_constants(c, memo);
-            const ContactHistory& h = history[k];
-            batch.sx[c] = h.tangential_spring_m.x; batch.sy[c] = h.tangential_spring_m.y; batch.sz[c] = h.tangential_spring_m.z;
-            batch.mx[c] = h.rolling_torque_N_m.x; batch.my[c] = h.rolling_torque_N_m.y; batch.mz[c] = h.rolling_torque_N_m.z;
-            if (batch.count == PairBatch::kCapacity) flush();
-        }
-        flush();
-        max_ratio = std::max(max_ratio, local_max);
-    }
-    max_overlap_ratio_ = max_ratio;
-    thread_forces_clear_ = false;  // until the gather has read them
-}
 
 void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const
 {
@@ -1572,13 +1261,7 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
     for (std::size_t i = 0; i < n; ++i) {
         Vec3 f = g * particles_.mass_kg[i];
         Vec3 torque{};
-        for (std::size_t t = 0; t < thread_force_N_.size(); ++t) {
-            if (i < thread_touched_[t].begin || i >= thread_touched_[t].end) continue;
-            f += thread_force_N_[t][i];
-            torque += thread_torque_N_m_[t][i];
-            thread_force_N_[t][i] = Vec3{};  // cleared for the next step's pairs while in cache
-            thread_torque_N_m_[t][i] = Vec3{};
-        }
+        pairs_.take(i, f, torque);
         for (std::uint32_t k = wall_contact_start_[i]; k < wall_contact_start_[i + 1]; ++k) {
             const WallContact& c = wall_contacts_[k];
             const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
@@ -1607,7 +1290,7 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
             if (tracked) max_move2 = std::max(max_move2, norm_squared(x[i] - reference[i]));
         }
     }
-    thread_forces_clear_ = true;
+    pairs_.gathered();
     if (bad >= 0) {
         const auto i = static_cast<std::size_t>(bad);
         throw SimulationError(concat(where_in_time(), ": particle ", particles_.id[i], " has a non-finite force or position (x = ",
@@ -1623,13 +1306,13 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
     // find the worst pair for the diagnosis
     std::size_t worst = 0;
     double worst_ratio = -1.0;
-    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
-        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+        const std::uint32_t i = pairs_.first(k), j = pairs_.second(k);
         const double ov = particles_.radius_m[i] + particles_.radius_m[j] - norm(particles_.position_m[i] - particles_.position_m[j]);
         const double ratio = ov / std::min(particles_.radius_m[i], particles_.radius_m[j]);
         if (ratio > worst_ratio) { worst_ratio = ratio; worst = k; }
     }
-    const std::uint32_t i = pair_i_[worst], j = pair_j_[worst];
+    const std::uint32_t i = pairs_.first(worst), j = pairs_.second(worst);
     const Vec3 p = particles_.position_m[i];
     throw SimulationError(concat(where_in_time(), ": particles ", particles_.id[i], " and ", particles_.id[j],
                                  " overlap by ", worst_ratio, " of the smaller radius (limit ", settings_.max_overlap_ratio,
@@ -1641,8 +1324,8 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
 
 void World::check_initial_overlaps() const
 {
-    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
-        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+        const std::uint32_t i = pairs_.first(k), j = pairs_.second(k);
         const double smaller = std::min(particles_.radius_m[i], particles_.radius_m[j]);
         const double ov = particles_.radius_m[i] + particles_.radius_m[j] - norm(particles_.position_m[i] - particles_.position_m[j]);
         if (ov > settings_.initial_overlap_tolerance * smaller)
@@ -1650,248 +1333,6 @@ void World::check_initial_overlaps() const
                                     " m = ", ov / smaller, " of the smaller radius; at most ",
                                     settings_.initial_overlap_tolerance, " (initial_overlap_tolerance) is accepted"));
     }
-}
-
-// ---- observables ---------------------------------------------------------------------------------
-
-std::size_t World::pair_contact_count() const
-{
-    std::size_t count = 0;
-    for (std::uint8_t t : pair_touching_) count += t;
-    return count;
-}
-
-std::vector<PairContactView> World::pair_contacts() const
-{
-    std::vector<PairContactView> out;
-    for (std::size_t k = 0; k < pair_i_.size(); ++k) {
-        if (!pair_touching_[k]) continue;
-        const std::uint32_t i = pair_i_[k], j = pair_j_[k];
-        PairContactView c;
-        c.id_a = particles_.id[i];
-        c.id_b = particles_.id[j];
-        c.overlap_m = particles_.radius_m[i] + particles_.radius_m[j] - norm(particles_.position_m[i] - particles_.position_m[j]);
-        c.history = pair_history_[k];
-        if (c.id_a > c.id_b) {
-            std::swap(c.id_a, c.id_b);
-            c.history.tangential_spring_m = -c.history.tangential_spring_m;
-            c.history.rolling_torque_N_m = -c.history.rolling_torque_N_m;
-        }
-        out.push_back(c);
-    }
-    std::sort(out.begin(), out.end(), [](const PairContactView& a, const PairContactView& b) {
-        return a.id_a != b.id_a ? a.id_a < b.id_a : a.id_b < b.id_b;
-    });
-    return out;
-}
-
-double World::kinetic_energy_J() const
-{
-    double e = 0.0;
-    for (std::size_t i = 0; i < particles_.size(); ++i)
-        e += 0.5 * particles_.mass_kg[i] * norm_squared(particles_.velocity_m_per_s[i]) +
-             0.5 / particles_.inverse_inertia_per_kg_m2[i] * norm_squared(particles_.angular_velocity_rad_per_s[i]);
-    return e;
-}
-
-double World::gravitational_potential_energy_J() const
-{
-    double e = 0.0;
-    for (std::size_t i = 0; i < particles_.size(); ++i)
-        e -= particles_.mass_kg[i] * dot(settings_.gravity_m_per_s2, particles_.position_m[i]);
-    return e;
-}
-
-Vec3 World::linear_momentum_kg_m_per_s() const
-{
-    Vec3 p{};
-    for (std::size_t i = 0; i < particles_.size(); ++i) p += particles_.velocity_m_per_s[i] * particles_.mass_kg[i];
-    return p;
-}
-
-Vec3 World::angular_momentum_kg_m2_per_s() const
-{
-    Vec3 l{};
-    for (std::size_t i = 0; i < particles_.size(); ++i)
-        l += cross(particles_.position_m[i], particles_.velocity_m_per_s[i] * particles_.mass_kg[i]) +
-             particles_.angular_velocity_rad_per_s[i] * (1.0 / particles_.inverse_inertia_per_kg_m2[i]);
-    return l;
-}
-
-double World::total_mass_kg() const
-{
-    double m = 0.0;
-    for (double mi : particles_.mass_kg) m += mi;
-    return m;
-}
-
-}  // namespace dipper::dem
-
-// ---- checkpoints ---------------------------------------------------------------------------------
-
-namespace dipper::dem {
-
-void World::write_state(StateWriter& out) const
-{
-    out.tag("dem-world");
-    out.value<std::uint64_t>(materials_.size());
-    for (std::size_t m = 0; m < materials_.size(); ++m) out.text(materials_.material(static_cast<MaterialIndex>(m)).name);
-    out.value<std::uint64_t>(walls_.size());
-    for (std::size_t w = 0; w < walls_.size(); ++w) out.text(wall_name(static_cast<int>(w)));
-    particles_.write_state(out);
-    out.value(time_s_);
-    out.value(step_s_);
-    out.value(step_count_);
-    out.value(rebuild_count_);
-    out.value<std::uint8_t>(prepared_);
-    out.value<std::uint8_t>(rebuild_needed_);
-    out.value<std::uint8_t>(step_checked_);
-    out.array(wall_removed_);
-    out.tag("mesh-poses");
-    for (const MeshWall& m : meshes_) {
-        out.value(m.rotation());
-        out.value(m.translation_m());
-        out.value(m.reference_point_m());
-        out.value(m.reference_velocity_m_per_s());
-        out.value(m.angular_velocity_rad_per_s());
-        out.value(m.pose_version());
-        out.value(m.mass_kg());
-    }
-    out.tag("neighbours");
-    out.array(pair_i_);
-    out.array(pair_j_);
-    out.array(pair_history_);
-    out.array(pair_touching_);
-    out.array(reference_position_m_);
-    out.array(stiffness_radius_N_per_m_);
-    out.array(reference_mesh_rotation_);
-    out.array(reference_mesh_translation_m_);
-    out.array(reference_mesh_version_);
-    out.value(skin_m_);
-    out.tag("wall-contacts");
-    // one list sorted by particle, those on convex bodies included (read_state splits it again)
-    const std::vector<WallContact> contacts = merged_wall_contacts();
-    std::vector<std::uint32_t> contact_start;
-    if (!wall_contact_start_.empty()) {
-        contact_start.assign(wall_contact_start_.size(), 0);
-        for (const WallContact& c : contacts) ++contact_start[c.particle + 1];
-        std::partial_sum(contact_start.begin(), contact_start.end(), contact_start.begin());
-    }
-    out.array(contacts);
-    out.array(contact_start);
-    out.array(candidate_start_);
-    out.array(candidates_);
-    out.array(wall_force_N_);
-    out.array(wall_torque_N_m_);
-    out.value(max_overlap_ratio_);
-}
-
-void World::read_state(StateReader& in)
-{
-    in.tag("dem-world");
-    const auto material_count = in.value<std::uint64_t>();
-    if (material_count != materials_.size())
-        in.fail(concat("the state has ", material_count, " materials, this world ", materials_.size()));
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const std::string name = in.text();
-        if (name != materials_.material(static_cast<MaterialIndex>(m)).name)
-            in.fail(concat("material ", m, " is '", name, "' in the state, '", materials_.material(static_cast<MaterialIndex>(m)).name,
-                           "' in this world"));
-    }
-    const auto wall_count = in.value<std::uint64_t>();
-    if (wall_count != walls_.size()) in.fail(concat("the state has ", wall_count, " walls, this world ", walls_.size()));
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-        const std::string name = in.text();
-        if (name != wall_name(static_cast<int>(w)))
-            in.fail(concat("wall ", w, " is '", name, "' in the state, '", wall_name(static_cast<int>(w)), "' in this world"));
-    }
-    particles_.read_state(in, materials_);
-    time_s_ = in.value<double>();
-    step_s_ = in.value<double>();
-    if (!(time_s_ >= 0.0 && std::isfinite(time_s_)) || !(step_s_ >= 0.0 && std::isfinite(step_s_)))
-        in.fail(concat("a time of ", time_s_, " s or a step of ", step_s_, " s"));
-    step_count_ = in.value<std::uint64_t>();
-    rebuild_count_ = in.value<std::uint64_t>();
-    prepared_ = in.value<std::uint8_t>() != 0;
-    rebuild_needed_ = in.value<std::uint8_t>() != 0;
-    step_checked_ = in.value<std::uint8_t>() != 0;
-    in.array(wall_removed_);
-    if (wall_removed_.size() != walls_.size()) in.fail("a removed-wall flag for each wall");
-    in.tag("mesh-poses");
-    for (MeshWall& m : meshes_) {
-        const auto rotation = in.value<Mat3>();
-        const auto translation = in.value<Vec3>();
-        const auto reference = in.value<Vec3>();
-        const auto velocity = in.value<Vec3>();
-        const auto spin = in.value<Vec3>();
-        const auto version = in.value<std::uint64_t>();
-        bool finite = is_finite(translation) && is_finite(reference) && is_finite(velocity) && is_finite(spin);
-        for (const auto& row : rotation.m)
-            for (double x : row) finite = finite && std::isfinite(x);
-        if (!finite) in.fail(concat("a pose of mesh '", m.name(), "' that is not finite"));
-        m.restore_pose(rotation, translation, reference, velocity, spin, version);
-        const double mass = in.value<double>();
-        if (!(mass >= 0.0 && std::isfinite(mass))) in.fail(concat("a mass of ", mass, " kg for mesh '", m.name(), "'"));
-        m.set_mass_kg(mass);
-    }
-    std::fill(mesh_moved_.begin(), mesh_moved_.end(), 1);
-    in.tag("neighbours");
-    in.array(pair_i_);
-    in.array(pair_j_);
-    in.array(pair_history_);
-    in.array(pair_touching_);
-    ++pair_list_version_;
-    in.array(reference_position_m_);
-    in.array(stiffness_radius_N_per_m_);
-    in.array(reference_mesh_rotation_);
-    in.array(reference_mesh_translation_m_);
-    in.array(reference_mesh_version_);
-    if (reference_mesh_rotation_.size() > meshes_.size()) in.fail("more mesh references than meshes");
-    skin_m_ = in.value<double>();
-    if (!(skin_m_ >= 0.0 && std::isfinite(skin_m_))) in.fail(concat("a neighbour skin of ", skin_m_, " m"));
-    in.tag("wall-contacts");
-    in.array(wall_contacts_);
-    in.array(wall_contact_start_);
-    in.array(candidate_start_);
-    in.array(candidates_);
-    in.array(wall_force_N_);
-    in.array(wall_torque_N_m_);
-    max_overlap_ratio_ = in.value<double>();
-
-    // indices must stay inside the arrays they index (a corrupt file must not crash the run)
-    const std::size_t n = particles_.size();
-    if (pair_j_.size() != pair_i_.size() || pair_history_.size() != pair_i_.size() || pair_touching_.size() != pair_i_.size())
-        in.fail("neighbour arrays of different lengths");
-    for (std::size_t k = 0; k < pair_i_.size(); ++k)
-        if (pair_i_[k] >= n || pair_j_[k] >= n) in.fail("a neighbour pair names a particle that does not exist");
-    // particles added since the last neighbour rebuild (a pour) are not in the reference and index arrays
-    // yet; the rebuild that rebuild_needed_ asks for takes them in
-    const auto sized = [&](std::size_t size, std::size_t expected) {
-        return rebuild_needed_ ? size <= expected : size == expected;
-    };
-    if (prepared_ && (!sized(reference_position_m_.size(), n) || reference_position_m_.size() != stiffness_radius_N_per_m_.size()))
-        in.fail("reference arrays do not match the particle count");
-    for (const WallContact& c : wall_contacts_)
-        if (c.particle >= n || c.wall < 0 || static_cast<std::size_t>(c.wall) >= walls_.size()) in.fail("a wall contact out of range");
-    if (prepared_ && (!sized(wall_contact_start_.size(), n + 1) || !sized(candidate_start_.size(), n + 1)))
-        in.fail("contact index arrays do not match the particle count");
-    if (!wall_contact_start_.empty() && wall_contact_start_.back() != wall_contacts_.size()) in.fail("wall contact index mismatch");
-    if (!candidate_start_.empty() && candidate_start_.back() != candidates_.size()) in.fail("wall candidate index mismatch");
-    if (!std::is_sorted(candidate_start_.begin(), candidate_start_.end()) || !std::is_sorted(wall_contact_start_.begin(), wall_contact_start_.end()))
-        in.fail("a wall contact or candidate index that does not ascend");
-    for (const MeshCandidate& c : candidates_) {
-        if (c.triangle == kPlaneCandidate ? c.mesh >= planes_.size() : (c.mesh >= meshes_.size() || c.triangle >= meshes_[c.mesh].mesh().triangle_count()))
-            in.fail("a wall candidate out of range");
-    }
-    if (reference_mesh_version_.size() != reference_mesh_rotation_.size() ||
-        reference_mesh_translation_m_.size() != reference_mesh_rotation_.size())
-        in.fail("mesh reference arrays differ in length");
-    split_candidates();
-    split_convex_contacts();
-    if (wall_force_N_.size() != walls_.size() || wall_torque_N_m_.size() != walls_.size())
-        wall_force_N_.assign(walls_.size(), Vec3{}), wall_torque_N_m_.assign(walls_.size(), Vec3{});
-    records_.clear();
-    records_stale_ = true;
 }
 
 }  // namespace dipper::dem

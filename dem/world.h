@@ -6,6 +6,7 @@
 #include "dem/contact_law.h"
 #include "dem/material.h"
 #include "dem/particle_store.h"
+#include "dem/sphere_pairs.h"
 #include "dem/walls.h"
 
 #include <cstdint>
@@ -45,13 +46,6 @@ struct PhaseSeconds {
     double wall_forces = 0.0;       ///< sphere-wall contacts: planes, meshes and coupled rigid bodies
     double convex_forces = 0.0;     ///< of wall_forces: the spheres' pairs with convex bodies (rocks), slowest thread
     double integration = 0.0;       ///< kicks, drift, force gathering, wall reactions and records
-};
-
-/// One touching sphere pair, for inspection and output.
-struct PairContactView {
-    std::uint32_t id_a = 0, id_b = 0;  ///< stable particle ids
-    double overlap_m = 0.0;
-    ContactHistory history;            ///< as seen from particle a
 };
 
 /// A spherical DEM world. Not thread-safe itself; uses OpenMP threads inside step().
@@ -149,7 +143,7 @@ public:
     const std::vector<ContactRecord>& last_contact_records() const;  ///< built when first asked for
     std::size_t pair_contact_count() const;          ///< touching sphere pairs in the last step
     std::size_t wall_contact_count() const { return wall_contacts_.size() + convex_contact_count_; }
-    std::size_t neighbour_pair_count() const { return pair_i_.size(); }
+    std::size_t neighbour_pair_count() const { return pairs_.size(); }
     double max_overlap_ratio() const { return max_overlap_ratio_; }  ///< largest overlap / smaller radius, last step
     std::vector<PairContactView> pair_contacts() const;
     double kinetic_energy_J() const;                 ///< translational + rotational
@@ -204,7 +198,7 @@ private:
     void move_prescribed_meshes(double t_end_s, double dt_s);
     bool needs_rebuild(double particle_move_m) const;
     void rebuild();
-    void build_wall_candidates(const Vec3& lo, double cell, const int dims[3], const std::vector<std::uint32_t>& cell_start);
+    void build_wall_candidates(const CellGrid& grid);
     /// Splits candidates_ into the per-particle lists of planes and open meshes, with their triangles beside
     /// them, and the pairs of spheres and convex bodies, in particle order.
     void split_candidates();
@@ -221,7 +215,6 @@ private:
     /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
     void apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const;
     void evaluate_forces(double dt_s, double half_kick_s);
-    void compute_pair_forces(double dt_s);
     void compute_wall_contacts(double dt_s);
     void find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit>& hits, std::vector<WallContact>& out) const;
     /// Sums each particle's forces and kicks it by half_kick_s; with next_drift also gives it the next
@@ -262,19 +255,8 @@ private:
     double time_s_ = 0.0, step_s_ = 0.0;
     std::uint64_t step_count_ = 0, rebuild_count_ = 0;
     bool prepared_ = false, rebuild_needed_ = true, step_checked_ = false;
-    bool thread_forces_clear_ = false;  ///< every per-thread force array is all zero (the gather clears what it reads)
 
-    // neighbour list: pairs (i < j) sorted by i then j, with their contact history
-    std::vector<std::uint32_t> pair_i_, pair_j_;
-    std::vector<ContactHistory> pair_history_;
-    std::vector<std::uint8_t> pair_touching_;
-    // pair forces and torques accumulated by each thread, added up per particle in thread order
-    std::vector<std::vector<Vec3>> thread_force_N_, thread_torque_N_m_;
-    /// The particles each thread's block of pairs touches: its force arrays hold sums there, and nothing elsewhere.
-    struct ParticleRange { std::uint32_t begin = 0, end = 0; };
-    std::vector<ParticleRange> thread_touched_;
-    std::uint64_t pair_list_version_ = 0;       ///< counts changes of the neighbour pair list
-    std::uint64_t touched_ranges_version_ = ~std::uint64_t{0};  ///< the list thread_touched_ was found for
+    SpherePairs pairs_;  ///< the neighbour list of sphere pairs with their contact history and forces
     std::vector<Vec3> reference_position_m_;
     std::vector<double> stiffness_radius_N_per_m_;  ///< k r per particle (eq. 4), refreshed at each rebuild
     std::vector<Mat3> reference_mesh_rotation_;     ///< each mesh's pose at the last rebuild
