@@ -173,7 +173,7 @@ void World::set_wall_mass_kg(int wall_id, double mass_kg)
     const auto m = static_cast<std::size_t>(walls_[static_cast<std::size_t>(wall_id)].index);
     meshes_[m].set_mass_kg(mass_kg);
     mesh_moved_[m] = 1;
-    convex_constants_stale_ = true;
+    convex_.forget_constants();
 }
 
 void World::sum_wall_reactions()
@@ -345,7 +345,7 @@ void World::finish_step(double dt_s)
     for (std::size_t f : thread_first_deep_contact_) first = std::min(first, f);
     for (std::size_t f : thread_first_deep_convex_) first_convex = std::min(first_convex, f);
     if (first != kNoContact || first_convex != kNoContact) {
-        const WallContact& c = first != kNoContact ? wall_contacts_[first] : convex_contacts_[first_convex];
+        const WallContact& c = first != kNoContact ? wall_contacts_[first] : convex_.contact(first_convex);
         const double ratio = c.overlap_m / particles_.radius_m[c.particle];
         const Vec3 p = particles_.position_m[c.particle];
         const WallMotion& wall = wall_motion_[static_cast<std::size_t>(c.wall)];
@@ -374,8 +374,8 @@ const std::vector<ContactRecord>& World::last_contact_records() const
     // the contacts of planes and open meshes in particle order, then those of convex bodies, in particle order
     std::vector<const WallContact*> contacts(wall_contacts_.size());
     for (std::size_t k = 0; k < wall_contacts_.size(); ++k) contacts[k] = &wall_contacts_[k];
-    for (std::size_t k = 0; k < convex_pairs_.size(); ++k)
-        if (convex_touching_[k]) contacts.push_back(&convex_contacts_[k]);
+    for (std::size_t k = 0; k < convex_.size(); ++k)
+        if (convex_.touching(k)) contacts.push_back(&convex_.contact(k));
     records_.resize(contacts.size());
 #pragma omp parallel for schedule(static) num_threads(threads_)
     for (std::size_t k = 0; k < contacts.size(); ++k) {
@@ -460,8 +460,7 @@ void World::rebuild()
     pairs_.rebuild(particles_, grid, skin_m_, old_to_new, threads_);
 
     // wall contacts keep their history (those on convex bodies too): renumbered and re-sorted by particle
-    for (std::size_t k = 0; k < convex_pairs_.size(); ++k)
-        if (convex_touching_[k]) wall_contacts_.push_back(convex_contacts_[k]);
+    convex_.append_contacts(wall_contacts_);
     for (WallContact& c : wall_contacts_) c.particle = c.particle < n ? old_to_new[c.particle] : std::uint32_t(n);
     wall_contacts_.erase(std::remove_if(wall_contacts_.begin(), wall_contacts_.end(),
                                         [n](const WallContact& c) { return c.particle >= n; }),
@@ -626,89 +625,14 @@ void World::build_wall_candidates(const CellGrid& grid)
     split_candidates();
 }
 
-namespace {
-
-bool has_vertex(const PackedTriangle& t, const Vec3& v) { return t.a == v || t.b == v || t.c == v; }
-/// The end points of edge k of a triangle, in the numbering of meshes::ClosestPoint (ab, bc, ca).
-std::pair<Vec3, Vec3> edge_ends(const PackedTriangle& t, int k) { return k == 0 ? std::pair{t.a, t.b} : k == 1 ? std::pair{t.b, t.c} : std::pair{t.c, t.a}; }
-
-}  // namespace
 
 void World::split_candidates()
 {
-    // Planes and open meshes stay with their particle; a convex body's triangles become one pair of the sphere
-    // and that body, with the faces copied beside it (candidates_ lists a particle's triangles mesh by mesh, so a
-    // body's faces are one run). The pairs are in particle order: the spheres' state is then read in one sweep.
+    // Planes and open meshes stay with their particle; the triangles of a convex body become one pair of the sphere
+    // and that body (ConvexPairs)
     const std::size_t n = candidate_start_.empty() ? 0 : candidate_start_.size() - 1;
-    convex_pairs_.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-        for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1];) {
-            const MeshCandidate mc = candidates_[k];
-            if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) {
-                ++k;
-                continue;
-            }
-            std::uint32_t run_end = k + 1;
-            while (run_end < candidate_start_[i + 1] && candidates_[run_end].mesh == mc.mesh) ++run_end;
-            convex_pairs_.push_back({mc.mesh, static_cast<std::uint32_t>(i), k, run_end});
-            k = run_end;
-        }
-    }
-
-    // the faces beside the pairs, in pair order, and the face across each edge of each: every pair's on its own
-    // (at full size, about 10^5 pairs per rebuild)
-    const auto pair_count = static_cast<std::ptrdiff_t>(convex_pairs_.size());
-    std::vector<std::uint32_t> first_candidate(convex_pairs_.size());
-    std::uint32_t faces = 0;
-    for (std::size_t q = 0; q < convex_pairs_.size(); ++q) {
-        ConvexPair& p = convex_pairs_[q];
-        first_candidate[q] = p.face_begin;
-        p.face_end = faces + (p.face_end - p.face_begin);
-        p.face_begin = faces;
-        faces = p.face_end;
-    }
-    convex_faces_.resize(faces);
-    convex_face_triangle_.resize(faces);
-    convex_face_across_.resize(faces);
-#pragma omp parallel for schedule(static) num_threads(threads_)
-    for (std::ptrdiff_t q = 0; q < pair_count; ++q) {
-        const ConvexPair& p = convex_pairs_[static_cast<std::size_t>(q)];
-        for (std::uint32_t f = p.face_begin; f < p.face_end; ++f) {
-            const std::uint32_t triangle = candidates_[first_candidate[static_cast<std::size_t>(q)] + (f - p.face_begin)].triangle;
-            convex_faces_[f] = meshes_[p.mesh].packed_body(triangle);
-            convex_face_triangle_[f] = static_cast<std::int32_t>(triangle);
-        }
-        for (std::uint32_t f = p.face_begin; f < p.face_end; ++f)
-            for (int k = 0; k < 3; ++k) {
-                const auto [e0, e1] = edge_ends(convex_faces_[f], k);
-                FaceAcross& across = convex_face_across_[f];
-                across.face[k] = kNoFace;
-                across.edge[k] = 0;
-                for (std::uint32_t g = p.face_begin; g < p.face_end; ++g) {
-                    const PackedTriangle& gt = convex_faces_[g];
-                    if (g == f || !has_vertex(gt, e0) || !has_vertex(gt, e1)) continue;
-                    across.face[k] = g;
-                    for (int j = 0; j < 3; ++j) {  // the edge of g with both ends (g is not degenerate: one)
-                        const auto [g0, g1] = edge_ends(gt, j);
-                        if ((g0 == e0 && g1 == e1) || (g0 == e1 && g1 == e0)) across.edge[k] = static_cast<std::uint8_t>(j);
-                    }
-                    break;
-                }
-            }
-    }
-    // a pair's contact is read only while it touches, so the contacts need no clearing
-    convex_contacts_.resize(convex_pairs_.size());
-    convex_constants_.assign(convex_pairs_.size(), ContactConstants{});
-    convex_touching_.assign(convex_pairs_.size(), 0);
-    convex_push_.assign(convex_pairs_.size(), Push{});
+    convex_.build(candidate_start_, candidates_, meshes_, threads_);
     convex_contact_count_ = 0;
-    convex_pair_start_.assign(n + 1, 0);
-    for (const ConvexPair& p : convex_pairs_) ++convex_pair_start_[p.particle + 1];
-    std::partial_sum(convex_pair_start_.begin(), convex_pair_start_.end(), convex_pair_start_.begin());
-    convex_pair_index_.resize(convex_pairs_.size());
-    for (std::size_t k = 0; k < convex_pairs_.size(); ++k) convex_pair_index_[convex_pair_start_[convex_pairs_[k].particle]++] = static_cast<std::uint32_t>(k);
-    for (std::size_t i = n; i > 0; --i) convex_pair_start_[i] = convex_pair_start_[i - 1];  // the fill moved each start to the next
-    if (n > 0) convex_pair_start_[0] = 0;
 
     // the other candidates, with their triangles beside them
     wall_candidate_start_.assign(n + 1, 0);
@@ -735,66 +659,26 @@ void World::split_candidates()
 void World::split_convex_contacts()
 {
     // a contact on a convex body goes to its pair (if the sphere is still within reach), the others stay
-    const std::size_t n = particles_.size();
-    std::size_t kept = 0;
-    for (std::size_t q = 0; q < wall_contacts_.size(); ++q) {
-        const WallContact& c = wall_contacts_[q];
+    convex_.take_contacts(wall_contacts_, [this](const WallContact& c) -> std::int64_t {
         const WallRef& ref = walls_[static_cast<std::size_t>(c.wall)];
-        if (!ref.is_mesh || !meshes_[static_cast<std::size_t>(ref.index)].convex()) {
-            wall_contacts_[kept++] = c;
-            continue;
-        }
-        const auto mesh = static_cast<std::uint32_t>(ref.index);
-        for (std::uint32_t slot = convex_pair_start_[c.particle]; slot < convex_pair_start_[c.particle + 1]; ++slot) {
-            const std::uint32_t k = convex_pair_index_[slot];
-            if (convex_pairs_[k].mesh != mesh) continue;
-            if (!convex_touching_[k]) {  // one contact per body (a second one only from an older rule)
-                convex_contacts_[k] = c;
-                convex_touching_[k] = 1;
-            }
-            break;
-        }  // no pair: the sphere has gone out of reach, and the contact has ended
-    }
-    wall_contacts_.resize(kept);
+        return ref.is_mesh && meshes_[static_cast<std::size_t>(ref.index)].convex() ? ref.index : -1;
+    });
+    const std::size_t n = particles_.size();
     wall_contact_start_.assign(n + 1, 0);
     for (const WallContact& c : wall_contacts_) ++wall_contact_start_[c.particle + 1];
     std::partial_sum(wall_contact_start_.begin(), wall_contact_start_.end(), wall_contact_start_.begin());
 }
 
-void World::share_convex_pairs()
+std::vector<WallContact> World::merged_wall_contacts() const
 {
-    // The pairs' contacts are shared out by their cost, not by the particles' blocks: those are equal in
-    // particles, and a settling column's lower half holds most of the pairs (in the thesis' calibration pile the
-    // first of two threads took six times the second's share). A pair touching at the last step (closest point,
-    // law and contact record) weighs as three apart: in that pile, at 1 s, weights of 1 and 4 left the first
-    // thread's pass 1.45 and 0.88 times as long as the second's. The shares are found at every step from the
-    // pairs' state, so a world read from a checkpoint shares them as the original did, and each thread sums its
-    // share's reactions on the bodies in pair order (the totals are then the same for a thread count).
-    const std::size_t pairs = convex_pairs_.size();
-    convex_pass_start_.assign(static_cast<std::size_t>(threads_) + 1, pairs);
-    convex_pass_start_[0] = 0;
-    if (threads_ == 1) return;
-    constexpr std::size_t kTouchingWeight = 3;
-    std::size_t touching = 0;
-    for (std::uint8_t t : convex_touching_) touching += t;
-    const std::size_t total = pairs + (kTouchingWeight - 1) * touching;
-    std::size_t sum = 0, t = 1;
-    for (std::size_t k = 0; k < pairs && t < static_cast<std::size_t>(threads_); ++k) {
-        while (t < static_cast<std::size_t>(threads_) && sum >= total * t / static_cast<std::size_t>(threads_)) convex_pass_start_[t++] = k;
-        sum += convex_touching_[k] ? kTouchingWeight : 1;
-    }
-}
-
-std::vector<World::WallContact> World::merged_wall_contacts() const
-{
-    const std::size_t n = convex_pair_start_.empty() ? 0 : convex_pair_start_.size() - 1;
-    if (convex_pairs_.empty() || wall_contact_start_.size() != n + 1) return wall_contacts_;
+    const std::size_t n = convex_.particle_count();
+    if (convex_.size() == 0 || wall_contact_start_.size() != n + 1) return wall_contacts_;
     std::vector<WallContact> all;
     all.reserve(wall_contacts_.size() + convex_contact_count_);
     for (std::size_t i = 0; i < n; ++i) {
         all.insert(all.end(), wall_contacts_.begin() + wall_contact_start_[i], wall_contacts_.begin() + wall_contact_start_[i + 1]);
-        for (std::uint32_t k = convex_pair_start_[i]; k < convex_pair_start_[i + 1]; ++k)
-            if (convex_touching_[convex_pair_index_[k]]) all.push_back(convex_contacts_[convex_pair_index_[k]]);
+        for (std::uint32_t k = convex_.first_of(i); k < convex_.last_of(i); ++k)
+            if (convex_.touching(convex_.pair_at(k))) all.push_back(convex_.contact(convex_.pair_at(k)));
     }
     return all;
 }
@@ -938,169 +822,6 @@ void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const V
     c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
 }
 
-bool World::edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
-                                  std::uint32_t& best_face) const
-{
-    // The closest point q of face F lies on its edge E. In a closed convex mesh E has one more face, G; q is the
-    // body's closest point when it is G's too (then x - q lies in the normal cone of E), or when x lies behind
-    // G's plane (then it lies in that cone by F's own condition). A point of G's interior, or of E computed from
-    // G and closer by round-off, is taken instead, as the search over all faces would take it. Anything else,
-    // or G not among the pair's faces, leaves the answer to that search (returns false, `best` as it came).
-    const FaceAcross& across = convex_face_across_[face_f];
-    const std::uint32_t g = across.face[best.local_index];
-    if (g == kNoFace) return false;
-    const PackedTriangle& gt = convex_faces_[g];
-    const double d = dot(xb - gt.a, gt.normal);
-    if (d <= 0.0 || d * d >= best.distance_squared) return true;
-    const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, gt.a, gt.b, gt.c);
-    const bool on_e = cp.feature == meshes::Feature::Face ||
-                      (cp.feature == meshes::Feature::Edge && cp.local_index == across.edge[best.local_index]);
-    if (!on_e && cp.distance_squared < best.distance_squared) return false;
-    if (cp.distance_squared < best.distance_squared) {
-        best = cp;
-        best_face = g;
-    }
-    return true;
-}
-
-std::size_t World::compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep,
-                                           Vec3* __restrict body_force, Vec3* __restrict body_torque)
-{
-    // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in front of one
-    // of the faces within reach touches none of them. A centre in front of some face lies outside, and the hull's
-    // closest point then lies on a face it is in front of (the direction to it is in the normal cone there); a
-    // face whose interior holds its closest point holds the hull's. So one contact per body at most, from the
-    // faces the centre faces. A centre behind every face within reach is inside the body: it is pushed out
-    // through the nearest face plane (an overlap beyond the radius, which the overlap limit stops).
-    //
-    // The pairs stream in order, but each meets its body's frame and its own contact record (read for its
-    // history, written when touching) out of the order the hardware prefetches: both are fetched a few pairs
-    // ahead, with the faces (on a bed of 20,000 spheres and 1,000 rocks the sphere-body phase took 13 % less
-    // time, docs/BENCHMARKS.md). The faces take a fixed six lines, their 4.1 faces' 394 bytes on average there:
-    // a loop over each pair's own count missed its end at every pair.
-    constexpr std::size_t kAhead = 8;
-    constexpr std::size_t kFaceLines = 6, kAcrossLines = 2;
-    auto prefetch = [](const void* at, std::size_t bytes) {
-        for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(static_cast<const char*>(at) + line);
-    };
-    std::size_t touching = 0;
-    for (std::size_t k = begin; k < end; ++k) {
-        const ConvexPair pair = convex_pairs_[k];
-        if (k + kAhead < end) {
-            const ConvexPair& next = convex_pairs_[k + kAhead];
-            prefetch(&convex_frames_[next.mesh], sizeof(ConvexFrame));
-            prefetch(&convex_contacts_[k + kAhead], sizeof(WallContact));
-            prefetch(&convex_constants_[k + kAhead], sizeof(ContactConstants));
-            prefetch(&convex_faces_[next.face_begin], kFaceLines * 64);
-            prefetch(&convex_face_across_[next.face_begin], kAcrossLines * 64);
-        }
-        const ConvexFrame& frame = convex_frames_[pair.mesh];
-        const std::uint32_t i = pair.particle;
-        const Vec3 x = particles_.position_m[i];
-        const double r = particles_.radius_m[i];
-        const Vec3 xb = frame.to_body * (x - frame.translation_m);
-        const double clear = r + frame.slack_m;
-        double farthest = -std::numeric_limits<double>::infinity();
-        std::uint32_t farthest_f = pair.face_begin;
-        bool separated = false;
-        for (std::uint32_t f = pair.face_begin; f < pair.face_end && !separated; ++f) {
-            const double d = dot(xb - convex_faces_[f].a, convex_faces_[f].normal);
-            separated = d >= clear;
-            if (d > farthest) {
-                farthest = d;
-                farthest_f = f;
-            }
-        }
-        bool touches = false;
-        Vec3 point_b, normal_b;
-        double overlap = 0.0;
-        std::uint32_t face = farthest_f;
-        if (!separated && farthest > 0.0) {
-            // the face the centre is farthest in front of comes first: when the closest point of a sphere on a
-            // face lies inside it, this is that face, and one query settles the body
-            const PackedTriangle& ft = convex_faces_[farthest_f];
-            meshes::ClosestPoint best_cp = meshes::closest_point_on_triangle(xb, ft.a, ft.b, ft.c);
-            if (best_cp.feature == meshes::Feature::Face) {
-                // over the face: its plane gives the distance, the normal and the point, with no square root or
-                // division in the way (on the bench bed two in three contacts, and 6 % off the pass)
-                touches = farthest < r;
-                normal_b = ft.normal;
-                point_b = xb - ft.normal * farthest;
-                overlap = r - farthest;
-            } else {
-                // a point on an edge is settled by the face across it (most closest points off a face lie on an
-                // edge); else by the other faces the centre is in front of
-                if (best_cp.feature != meshes::Feature::Edge || !edge_point_is_closest(farthest_f, xb, best_cp, face)) {
-                    for (std::uint32_t f = pair.face_begin; f < pair.face_end; ++f) {
-                        const PackedTriangle& pt = convex_faces_[f];
-                        const double d = dot(xb - pt.a, pt.normal);
-                        if (f == farthest_f || d <= 0.0 || d * d >= best_cp.distance_squared) continue;
-                        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
-                        if (cp.distance_squared < best_cp.distance_squared) {
-                            face = f;
-                            best_cp = cp;
-                            if (cp.feature == meshes::Feature::Face) break;
-                        }
-                    }
-                }
-                if (best_cp.distance_squared < r * r) {
-                    touches = true;
-                    const double dist = std::sqrt(best_cp.distance_squared);
-                    point_b = best_cp.point;
-                    normal_b = dist > 1e-12 * r ? (xb - best_cp.point) * (1.0 / dist) : convex_faces_[face].normal;
-                    overlap = r - dist;
-                }
-            }
-        } else if (!separated) {
-            touches = true;
-            normal_b = convex_faces_[farthest_f].normal;
-            point_b = xb - normal_b * farthest;
-            overlap = r - farthest;
-        }
-        WallContact& c = convex_contacts_[k];
-        if (!touches) {
-            if (convex_touching_[k]) {  // separated: the history of this contact ends
-                convex_touching_[k] = 0;
-                convex_push_[k] = Push{};
-            }
-            continue;
-        }
-        ++touching;
-        c.first_step = !convex_touching_[k];
-        if (c.first_step) c.history = ContactHistory{};
-        convex_touching_[k] = 1;
-        c.particle = i;
-        c.wall = frame.wall;
-        c.triangle = convex_face_triangle_[face];
-        c.normal = transposed_times(frame.to_body, normal_b);
-        c.point = transposed_times(frame.to_body, point_b) + frame.translation_m;
-        c.overlap_m = overlap;
-        const Vec3 v = particles_.velocity_m_per_s[i];
-        const Vec3 w = particles_.angular_velocity_rad_per_s[i];
-        // the constants of the law (eq. 4, 6, 8) of this sphere's kind against this body
-        const MaterialIndex mat = particles_.material[i];
-        const double m = particles_.mass_kg[i];
-        const WallMotion& motion = frame.motion;
-        const PairCoefficients& p = materials_.pair_unchecked(mat, motion.material);
-        ContactConstants& constants = convex_constants_[k];
-        if (constants.normal_stiffness_N_per_m == 0.0)
-            constants = contact_constants(wall_normal_stiffness(bulk_modulus_Pa_[mat], r, p.normal_stiffness_scale),
-                                          motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r, p);
-        const Vec3 relative_velocity = v + cross(w, c.point - x) - motion.velocity_at(c.point);
-        c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - motion.angular_velocity_rad_per_s, constants,
-                                         c.history, dt_s);
-        c.relative_displacement_m = relative_velocity * dt_s;
-        const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
-        convex_push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
-        // the body's reaction, while the contact is in cache
-        const Vec3 on_wall = -force;
-        body_force[frame.wall] += on_wall;
-        body_torque[frame.wall] += cross(c.point - motion.reference_point_m, on_wall) - c.forces.rolling_torque_N_m;
-        if (first_deep == kNoContact && c.overlap_m / r > settings_.max_overlap_ratio) first_deep = k;
-    }
-    return touching;
-}
-
 void World::wall_thread_block(int t, std::size_t& begin, std::size_t& end) const
 {
     // Blocks of particles with equal work: a wall candidate weighs as much as kCandidateWeight particles
@@ -1148,11 +869,7 @@ void World::compute_wall_contacts(double dt_s)
     thread_first_deep_contact_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
-    share_convex_pairs();
-    if (convex_constants_stale_) {
-        std::fill(convex_constants_.begin(), convex_constants_.end(), ContactConstants{});
-        convex_constants_stale_ = false;
-    }
+    convex_.start_step(threads_);
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
         // the records of the meshes moved (or given a mass) since the last wall phase: in a coupled bed every rock
@@ -1191,8 +908,8 @@ void World::compute_wall_contacts(double dt_s)
         std::size_t first_deep_convex = kNoContact;
         auto convex_start = std::chrono::steady_clock::now();
         const auto ut = static_cast<std::size_t>(t);
-        convex_touching += compute_convex_contacts(convex_pass_start_[ut], convex_pass_start_[ut + 1], dt_s, first_deep_convex,
-                                                   wall_force, wall_torque);
+        convex_touching += convex_.compute(convex_.pass_begin(t), convex_.pass_end(t), particles_, convex_frames_, materials_, bulk_modulus_Pa_,
+                                           settings_.max_overlap_ratio, dt_s, first_deep_convex, wall_force, wall_torque);
         thread_convex_seconds_[ut] = seconds_since(convex_start);
         thread_first_deep_convex_[ut] = first_deep_convex;
 
@@ -1268,11 +985,7 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
             f += force;
             torque += cross(c.point - x[i], force) + c.forces.rolling_torque_N_m;
         }
-        for (std::uint32_t k = convex_pair_start_[i]; k < convex_pair_start_[i + 1]; ++k) {
-            const Push& push = convex_push_[convex_pair_index_[k]];
-            f += push.force_N;
-            torque += push.torque_N_m;
-        }
+        convex_.push(i, f, torque);
         if (!next_drift) {  // within a run of steps the force is used here and nowhere else
             particles_.force_N[i] = f;
             particles_.torque_N_m[i] = torque;

@@ -4,9 +4,11 @@
 #include "core/contact_record.h"
 #include "core/vec3.h"
 #include "dem/contact_law.h"
+#include "dem/convex_pairs.h"
 #include "dem/material.h"
 #include "dem/particle_store.h"
 #include "dem/sphere_pairs.h"
+#include "dem/wall_contact.h"
 #include "dem/walls.h"
 
 #include <cstdint>
@@ -156,29 +158,6 @@ public:
 
 private:
     struct WallRef { bool is_mesh; int index; };
-    /// What a wall contact's force needs of its wall, copied at the start of each wall phase into one small
-    /// record per wall (a mesh's own object is large and spread over many cache lines).
-    struct WallMotion {
-        Vec3 reference_point_m, reference_velocity_m_per_s, angular_velocity_rad_per_s;  ///< zero for a plane
-        double mass_kg;                                                                  ///< 0: immovable
-        MaterialIndex material;
-        Vec3 velocity_at(const Vec3& point_m) const
-        {
-            return reference_velocity_m_per_s + cross(angular_velocity_rad_per_s, point_m - reference_point_m);
-        }
-    };
-    struct WallContact {
-        std::uint32_t particle;
-        std::int32_t wall, triangle;
-        Vec3 normal, point, relative_displacement_m;
-        double overlap_m;
-        bool first_step;  ///< no contact of last step continues into this one
-        ContactHistory history;
-        ContactForces forces;
-    };
-    /// A wall within reach of a particle: triangle of a mesh, or plane `mesh` when triangle == kPlaneCandidate.
-    struct MeshCandidate { std::uint32_t mesh, triangle; };
-    static constexpr std::uint32_t kPlaneCandidate = 0xffffffffu;
     /// A touched wall feature before the one-contact-per-feature filter.
     struct WallHit {
         std::int32_t wall, triangle;
@@ -204,14 +183,8 @@ private:
     void split_candidates();
     /// Moves the history of wall_contacts_ on convex bodies into their pairs; the rest stay, indexed by particle.
     void split_convex_contacts();
-    /// convex_pass_start_ from the pairs' state at the start of this step (compute_wall_contacts)
-    void share_convex_pairs();
     /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
     std::vector<WallContact> merged_wall_contacts() const;
-    /// The contacts of convex pairs [begin, end), with the first pair past the overlap limit in first_deep; returns
-    /// how many touch. Each touching pair's reaction on its body is added to body_force and body_torque (by wall).
-    std::size_t compute_convex_contacts(std::size_t begin, std::size_t end, double dt_s, std::size_t& first_deep,
-                                        Vec3* body_force, Vec3* body_torque);
     /// Fills a wall contact's forces from its geometry and history (DESIGN 1.1).
     void apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const Vec3& w, double r, double dt_s) const;
     void evaluate_forces(double dt_s, double half_kick_s);
@@ -235,15 +208,6 @@ private:
     std::vector<WallRef> walls_;
     std::unordered_set<std::string> wall_names_;  ///< of walls_, for check_wall_name (a pile has 20,000 rocks)
     std::vector<WallMotion> wall_motion_;  ///< beside walls_, refreshed by compute_wall_contacts
-    /// What the sphere pairs of a convex body read of it, in four cache lines (the geometry in the first two):
-    /// the pairs meet their bodies in no order, so each is fetched ahead of its pair (compute_convex_contacts).
-    struct alignas(64) ConvexFrame {
-        Mat3 to_body;          ///< the transposed rotation
-        Vec3 translation_m;
-        double slack_m;
-        std::int32_t wall;
-        WallMotion motion;
-    };
     std::vector<ConvexFrame> convex_frames_;  ///< beside meshes_ (convex ones only), refreshed by compute_wall_contacts
     std::vector<std::int32_t> mesh_wall_id_;  ///< wall id of each mesh
     std::vector<std::uint8_t> mesh_moved_;    ///< beside meshes_: posed or given a mass since the last wall phase
@@ -276,33 +240,7 @@ private:
     std::vector<std::uint32_t> wall_particles_;       ///< the particles with a wall candidate, in order
     std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside wall_candidates_ (planes: unused)
     std::vector<TriangleIds> candidate_ids_;           ///< beside wall_candidates_, read only for touched triangles
-    /// A sphere within reach of a convex body (a rock's hull): at most one contact (find the reason at
-    /// compute_convex_contacts), kept in place from step to step like a sphere pair's. The pairs are in particle
-    /// order, so that the spheres' state is read in one sweep (each thread's pairs are one block of them).
-    struct ConvexPair { std::uint32_t mesh, particle, face_begin, face_end; };
-    /// Whether `best`, the closest point of face face_f of a convex pair on one of its edges, is the body's:
-    /// decided from the face across that edge, which may replace it (`best`, `best_face`).
-    bool edge_point_is_closest(std::uint32_t face_f, const Vec3& xb, meshes::ClosestPoint& best,
-                               std::uint32_t& best_face) const;
-    std::vector<ConvexPair> convex_pairs_;
-    /// beside convex_pairs_: the constants of the pair's law (eq. 4, 6, 8), found when it first touches after a
-    /// rebuild; a stiffness of zero (never a pair's: C_norm > 0) marks them not found yet
-    std::vector<ContactConstants> convex_constants_;
-    bool convex_constants_stale_ = false;  ///< a body's mass changed: every pair's constants are found again
-    std::vector<PackedTriangle> convex_faces_;       ///< body frame, the faces within reach of each pair in turn
-    std::vector<std::int32_t> convex_face_triangle_; ///< beside convex_faces_: the mesh's triangle
-    /// The face across each edge (ab, bc, ca) of a pair's face among the pair's faces (the first in order that
-    /// shares both ends, kNoFace if none), and which edge of it that is; found at each rebuild by comparing
-    /// every two faces of a pair (a pair holds the few faces within reach of one sphere).
-    struct FaceAcross { std::uint32_t face[3]; std::uint8_t edge[3]; };
-    static constexpr std::uint32_t kNoFace = 0xffffffffu;
-    std::vector<FaceAcross> convex_face_across_;     ///< beside convex_faces_
-    std::vector<WallContact> convex_contacts_;       ///< beside convex_pairs_: the contact of this step, if touching
-    std::vector<std::uint8_t> convex_touching_;      ///< beside convex_pairs_
-    struct Push { Vec3 force_N, torque_N_m; };       ///< on the particle, about its centre
-    std::vector<Push> convex_push_;                  ///< beside convex_pairs_ (zero when apart)
-    std::vector<std::uint32_t> convex_pair_start_, convex_pair_index_;  ///< each particle's pairs
-    std::vector<std::size_t> convex_pass_start_;     ///< the pairs whose contacts each thread computes: shares of equal cost
+    ConvexPairs convex_;  ///< the spheres within reach of convex bodies, with their contacts
     std::size_t convex_contact_count_ = 0;
     std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit
     std::vector<double> thread_convex_seconds_;           ///< per thread: its pass over its convex pairs, this step
@@ -316,7 +254,6 @@ private:
     std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
     std::vector<std::vector<Vec3>> thread_wall_force_N_, thread_wall_torque_N_m_;  ///< per thread and wall, this step
-    static constexpr std::size_t kNoContact = static_cast<std::size_t>(-1);
     std::vector<std::size_t> thread_first_deep_contact_;  ///< per thread: first wall contact past the overlap limit
     mutable std::vector<ContactRecord> records_;
     mutable bool records_stale_ = true;

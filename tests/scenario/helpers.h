@@ -30,4 +30,19 @@ inline std::string read_text_file(const std::string& path)
     return s.str();
 }
 
+/// A scenario of 2 t of 300 mm spheres off to the side on the ground, for 1 s on one thread, with `extra` keys
+/// added (a shovel, rocks, wear).
+inline std::string machine_scenario(const std::string& extra)
+{
+    return concat(R"(dipper_scenario: 1
+name: machine
+threads: 1
+time: {duration_s: 1.0}
+planes:
+  - {name: ground, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+fills:
+  - {mass_kg: 2000, box: {min_m: [-20, -1, 0], max_m: [-18, 1, 1]}, sizes: [{radius_m: 0.15, mass_fraction: 1}]}
+)", extra);
+}
+
 }  // namespace dipper::test
