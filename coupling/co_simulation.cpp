@@ -61,7 +61,8 @@ rigid::MotionCurves dig_speed_scaled(const rigid::MotionCurves& cycle, double fa
     return rigid::MotionCurves::from_samples(std::move(samples), concat(cycle.source(), ", dig ", factor, " times as fast"));
 }
 
-CoSimulation::CoSimulation(std::unique_ptr<dem::World> dem, CoSimulationSettings settings) : dem_(std::move(dem))
+CoSimulation::CoSimulation(std::unique_ptr<dem::World> dem, CoSimulationSettings settings)
+    : dem_(std::move(dem)), domain_(settings.dynamic_domain)
 {
     if (!dem_) throw InputError("CoSimulation: no DEM world given");
     given_walls_ = dem_->wall_count();
@@ -223,6 +224,7 @@ void CoSimulation::step()
     check_tunnelling();
     add_rock_wear();
     track_passes();
+    domain_.update(*coupled_, coupled_->coupling_step_s());  // what is at rest away from moving things: frozen
 }
 
 void CoSimulation::run_until(double t_s)
@@ -267,6 +269,7 @@ void CoSimulation::write_state(StateWriter& out) const
     out.value(without_lip_sum_);
     out.value(without_lip_peak_);
     out.value(dig_samples_);
+    domain_.write_state(out);
 }
 
 void CoSimulation::read_state(StateReader& in)
@@ -288,6 +291,7 @@ void CoSimulation::read_state(StateReader& in)
     without_lip_sum_ = in.value<double>();
     without_lip_peak_ = in.value<double>();
     dig_samples_ = in.value<std::uint64_t>();
+    domain_.read_state(in);
 }
 
 double CoSimulation::tonnage_t() const

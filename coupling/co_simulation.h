@@ -4,6 +4,7 @@
 #pragma once
 
 #include "coupling/coupled_world.h"
+#include "coupling/dynamic_domain.h"
 #include "dem/world.h"
 #include "meshes/machine_geometry.h"
 #include "meshes/triangle_locator.h"
@@ -36,6 +37,8 @@ struct CoSimulationSettings {
     /// Rocks will be added: every DEM wall must then have a rigid material (rigid_material_names); without
     /// rocks a wall of another material touches spheres only.
     bool rocks = false;
+    /// Spheres and rocks at rest away from moving things frozen (coupling/dynamic_domain.h); off by default.
+    DynamicDomainSettings dynamic_domain;
 };
 
 /// The rope shovel's motion: the thesis' loading cycle, a dig followed by a return to the start, or curves.
@@ -121,6 +124,8 @@ public:
     const rigid::RigidWorld& rigid() const { return *rigid_; }
     coupling::CoupledWorld& coupled() { return *coupled_; }
     const coupling::CoupledWorld& coupled() const { return *coupled_; }
+    /// Which bodies are frozen now (all awake unless CoSimulationSettings::dynamic_domain is enabled).
+    const DynamicDomain& dynamic_domain() const { return domain_; }
 
     // ---- the machine
     bool has_shovel() const { return dipper_body_ >= 0; }
@@ -182,6 +187,7 @@ private:
     std::unique_ptr<dem::World> dem_;
     std::unique_ptr<rigid::RigidWorld> rigid_;
     std::unique_ptr<coupling::CoupledWorld> coupled_;
+    DynamicDomain domain_;
     std::size_t given_walls_ = 0;  ///< DEM walls 0 .. n-1 came with the DEM world
     std::vector<std::pair<std::string, rigid::BodyId>> mesh_bodies_;  ///< DEM mesh wall name, Bullet body
     std::vector<std::pair<rigid::BodyId, dem::PrescribedMotion>> moving_meshes_;  ///< kinematic in Bullet

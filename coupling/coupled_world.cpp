@@ -300,8 +300,9 @@ void CoupledWorld::move_surfaces(double fraction, double interval_s)
         const Pose& a = before_[k];
         const Pose& b = after_[k];
         const Vec3 spin = spin_rad_[k];
-        if (!bodies_[k].dynamic && spin == Vec3{} && a.centre_m == b.centre_m && a.origin_m == b.origin_m) {
-            // a fixed part: place it once, at rest, and leave it (no vertex work, no neighbour-list churn)
+        if (spin == Vec3{} && a.centre_m == b.centre_m && a.origin_m == b.origin_m) {
+            // a fixed part or a frozen rock: place it once, at rest, and leave it (no vertex work, no neighbour-list
+            // churn)
             const dem::MeshWall& wall = dem_.mesh_wall(bodies_[k].wall);
             if (wall.velocity_at(wall.reference_point_m()) == Vec3{} && wall.angular_velocity_rad_per_s() == Vec3{} &&
                 wall.translation_m() == b.origin_m)

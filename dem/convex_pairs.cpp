@@ -184,6 +184,10 @@ std::size_t ConvexPairs::compute(std::size_t begin, std::size_t end, const Parti
         }
         const ConvexFrame& frame = frames[pair.mesh];
         const std::uint32_t i = pair.particle;
+        if (frame.frozen && particles.frozen[i]) {  // two frozen bodies: the contact stays as it was, no reaction
+            touching += touching_[k];
+            continue;
+        }
         const Vec3 x = particles.position_m[i];
         const double r = particles.radius_m[i];
         const Vec3 xb = frame.to_body * (x - frame.translation_m);

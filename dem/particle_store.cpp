@@ -18,6 +18,7 @@ void ParticleStore::reserve(std::size_t n)
     for (auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) v->reserve(n);
     material.reserve(n);
     id.reserve(n);
+    frozen.reserve(n);
 }
 
 std::uint32_t ParticleStore::add(const ParticleSpawn& s, const MaterialTable& materials, const std::string& where)
@@ -57,6 +58,7 @@ std::uint32_t ParticleStore::add(const ParticleSpawn& s, const MaterialTable& ma
     inverse_inertia_per_kg_m2.push_back(1.0 / inertia);
     material.push_back(s.material);
     id.push_back(next_id_);
+    frozen.push_back(0);
     return next_id_++;
 }
 
@@ -81,6 +83,8 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order)
     apply_order(material, order, sm);
     std::vector<std::uint32_t> si;
     apply_order(id, order, si);
+    std::vector<std::uint8_t> sf;
+    apply_order(frozen, order, sf);
 }
 
 void ParticleStore::write_state(StateWriter& out) const
@@ -90,6 +94,7 @@ void ParticleStore::write_state(StateWriter& out) const
     for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) out.array(*v);
     out.array(material);
     out.array(id);
+    out.array(frozen);
     out.value(next_id_);
 }
 
@@ -100,13 +105,16 @@ void ParticleStore::read_state(StateReader& in, const MaterialTable& materials)
     for (auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) in.array(*v);
     in.array(material);
     in.array(id);
+    in.array(frozen);
     next_id_ = in.value<std::uint32_t>();
     const std::size_t n = position_m.size();
     for (const auto* v : {&velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m})
         if (v->size() != n) in.fail("particle arrays of different lengths");
     for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2})
         if (v->size() != n) in.fail("particle arrays of different lengths");
-    if (material.size() != n || id.size() != n) in.fail("particle arrays of different lengths");
+    if (material.size() != n || id.size() != n || frozen.size() != n) in.fail("particle arrays of different lengths");
+    for (std::uint8_t f : frozen)
+        if (f > 1) in.fail(concat("a particle's frozen flag of ", int(f), "; expected 0 or 1"));
     for (MaterialIndex m : material)
         if (m >= materials.size()) in.fail(concat("particle material ", m, " beyond the ", materials.size(), " materials"));
     // what a run wrote is finite and physical; a file changed behind its checksum must not reach the grid

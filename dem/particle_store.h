@@ -49,6 +49,9 @@ public:
     std::vector<double> radius_m, mass_kg, inverse_mass_per_kg, inverse_inertia_per_kg_m2;
     std::vector<MaterialIndex> material;
     std::vector<std::uint32_t> id;
+    /// 1 while the particle is frozen (World::set_frozen): held where it is, at rest, out of the integration and of
+    /// the contacts with other frozen bodies.
+    std::vector<std::uint8_t> frozen;
 
 private:
     std::uint32_t next_id_ = 0;

@@ -110,6 +110,7 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
     const double* __restrict r = p.radius_m.data();
     const double* __restrict m = p.mass_kg.data();
     const MaterialIndex* __restrict mat = p.material.data();
+    const std::uint8_t* __restrict frozen = p.frozen.data();
     const double* __restrict kr = stiffness_radius_N_per_m.data();
     const std::uint32_t* __restrict pi = pair_i_.data();
     const std::uint32_t* __restrict pj = pair_j_.data();
@@ -177,6 +178,7 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
         MaterialIndex memo_a = 0, memo_b = 0;
         for (std::size_t k = begin; k < end; ++k) {
             const std::uint32_t i = pi[k], j = pj[k];
+            if (frozen[i] & frozen[j]) continue;  // two frozen particles: the contact stays as it was
             const Vec3 d = x[i] - x[j];
             const double dist2 = norm_squared(d);
             const double rsum = r[i] + r[j];

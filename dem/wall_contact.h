@@ -50,6 +50,7 @@ struct alignas(64) ConvexFrame {
     Vec3 translation_m;
     double slack_m;
     std::int32_t wall;
+    std::uint8_t frozen;  ///< World::set_wall_frozen: its pairs with frozen particles are left as they were
     WallMotion motion;
 };
 

@@ -69,9 +69,42 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
     wall_force_N_.resize(walls_.size());
     wall_torque_N_m_.resize(walls_.size());
     wall_removed_.push_back(0);
+    wall_frozen_.push_back(0);
     rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
+}
+
+void World::set_frozen(std::size_t i, bool frozen)
+{
+    if (i >= particles_.size()) throw InputError(concat("set_frozen: particle index ", i, " of ", particles_.size()));
+    particles_.frozen[i] = frozen ? 1 : 0;
+    if (!frozen) return;
+    particles_.velocity_m_per_s[i] = Vec3{};
+    particles_.angular_velocity_rad_per_s[i] = Vec3{};
+    particles_.force_N[i] = Vec3{};
+    particles_.torque_N_m[i] = Vec3{};
+}
+
+void World::set_wall_frozen(int wall_id, bool frozen)
+{
+    if (!is_mesh(wall_id) || !mesh_wall(wall_id).convex())
+        throw InputError(concat("set_wall_frozen: wall ", wall_id, " is not a convex mesh"));
+    const auto w = static_cast<std::size_t>(wall_id);
+    if (wall_frozen_[w] == (frozen ? 1 : 0)) return;
+    wall_frozen_[w] = frozen ? 1 : 0;
+    mesh_moved_[static_cast<std::size_t>(walls_[w].index)] = 1;  // its frame is made again with the flag
+}
+
+bool World::wall_frozen(int wall_id) const
+{
+    wall_name(wall_id);  // checks the id
+    return wall_frozen_[static_cast<std::size_t>(wall_id)] != 0;
+}
+
+std::size_t World::frozen_count() const
+{
+    return static_cast<std::size_t>(std::count(particles_.frozen.begin(), particles_.frozen.end(), std::uint8_t{1}));
 }
 
 void World::remove_wall(int wall_id)
@@ -117,6 +150,7 @@ int World::add_mesh(meshes::TriangleMesh mesh, MaterialIndex material, const std
     wall_force_N_.resize(walls_.size());
     wall_torque_N_m_.resize(walls_.size());
     wall_removed_.push_back(0);
+    wall_frozen_.push_back(0);
     rebuild_needed_ = true;
     step_checked_ = false;
     return static_cast<int>(walls_.size() - 1);
@@ -288,9 +322,11 @@ double World::kick_and_drift(double dt_s)
     auto& w = particles_.angular_velocity_rad_per_s;
     const bool tracked = reference_position_m_.size() == n;
     const Vec3* reference = reference_position_m_.data();
+    const std::uint8_t* frozen = particles_.frozen.data();
     double max_move2 = 0.0;
 #pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : max_move2)
     for (std::size_t i = 0; i < n; ++i) {
+        if (frozen[i]) continue;
         v[i] += particles_.force_N[i] * (0.5 * dt_s * particles_.inverse_mass_per_kg[i]);
         w[i] += particles_.torque_N_m[i] * (0.5 * dt_s * particles_.inverse_inertia_per_kg_m2[i]);
         x[i] += v[i] * dt_s;
@@ -883,7 +919,8 @@ void World::compute_wall_contacts(double dt_s)
             const auto w = static_cast<std::size_t>(mesh_wall_id_[m]);
             wall_motion_[w] = {mw.reference_point_m(), mw.reference_velocity_m_per_s(), mw.angular_velocity_rad_per_s(), mw.mass_kg(), mw.material()};
             if (mw.convex())
-                convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), mesh_wall_id_[m], wall_motion_[w]};
+                convex_frames_[m] = {mw.rotation().transposed(), mw.translation_m(), mw.convex_slack_m(), mesh_wall_id_[m], wall_frozen_[w],
+                                     wall_motion_[w]};
         }
         const int t = omp_get_thread_num();
         std::size_t begin, end;
@@ -972,6 +1009,7 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
     auto& x = particles_.position_m;
     auto& v = particles_.velocity_m_per_s;
     auto& w = particles_.angular_velocity_rad_per_s;
+    const std::uint8_t* frozen = particles_.frozen.data();
     double max_move2 = 0.0;
     int bad = -1;
 #pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : bad, max_move2)
@@ -979,6 +1017,7 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
         Vec3 f = g * particles_.mass_kg[i];
         Vec3 torque{};
         pairs_.take(i, f, torque);
+        if (frozen[i]) continue;  // at rest where it is (its share of the pairs' sums is cleared all the same)
         for (std::uint32_t k = wall_contact_start_[i]; k < wall_contact_start_[i + 1]; ++k) {
             const WallContact& c = wall_contacts_[k];
             const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;

@@ -75,6 +75,18 @@ public:
     /// Receives every sphere-wall contact of each step (see core/contact_record.h).
     void set_contact_consumer(ContactConsumer consumer) { consumer_ = std::move(consumer); }
 
+    // ---- frozen bodies (what coupling::DynamicDomain decides) --------------------------------------
+    /// Freezes particle i (dense index) or lets it go. A frozen particle stays where it is, at rest: it is not
+    /// integrated, and its contacts with other frozen particles and frozen convex walls are left as they were
+    /// (their springs keep their history); anything else still meets it as a fixed body. Freezing zeroes its
+    /// velocities and forces, so that it starts from rest when it is let go.
+    void set_frozen(std::size_t i, bool frozen);
+    /// Freezes a convex mesh wall (a rock the rigid side holds still) or lets it go: its pairs with frozen
+    /// particles are left as they were, and no reaction comes from them.
+    void set_wall_frozen(int wall_id, bool frozen);
+    bool wall_frozen(int wall_id) const;
+    std::size_t frozen_count() const;  ///< frozen particles
+
     // ---- running -------------------------------------------------------------------------------
     /// Advances one step: half kick and drift, walls moved, neighbour lists refreshed if needed,
     /// forces, second half kick. Throws SimulationError with a diagnosis if the state blows up.
@@ -213,6 +225,7 @@ private:
     std::vector<std::uint8_t> mesh_moved_;    ///< beside meshes_: posed or given a mass since the last wall phase
     std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
     std::vector<std::uint8_t> wall_removed_;  ///< per wall id: 1 once remove_wall took it out
+    std::vector<std::uint8_t> wall_frozen_;   ///< per wall id: 1 while set_wall_frozen holds it
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
 

@@ -26,6 +26,7 @@ void World::write_state(StateWriter& out) const
     out.value<std::uint8_t>(rebuild_needed_);
     out.value<std::uint8_t>(step_checked_);
     out.array(wall_removed_);
+    out.array(wall_frozen_);
     out.tag("mesh-poses");
     for (const MeshWall& m : meshes_) {
         out.value(m.rotation());
@@ -93,6 +94,11 @@ void World::read_state(StateReader& in)
     step_checked_ = in.value<std::uint8_t>() != 0;
     in.array(wall_removed_);
     if (wall_removed_.size() != walls_.size()) in.fail("a removed-wall flag for each wall");
+    in.array(wall_frozen_);
+    if (wall_frozen_.size() != walls_.size()) in.fail("a frozen-wall flag for each wall");
+    for (std::size_t w = 0; w < walls_.size(); ++w)
+        if (wall_frozen_[w] > 1 || (wall_frozen_[w] && !(walls_[w].is_mesh && meshes_[static_cast<std::size_t>(walls_[w].index)].convex())))
+            in.fail(concat("wall '", wall_name(static_cast<int>(w)), "' frozen; only convex meshes can be"));
     in.tag("mesh-poses");
     for (MeshWall& m : meshes_) {
         const auto rotation = in.value<Mat3>();

@@ -215,6 +215,8 @@ BodyId RigidWorld::add_rock(const ConvexPolyhedron& shape, double density, int m
     b->shape = std::move(hull);
     const double mass = density * shape.volume_m3();
     const btVector3 moments(inertia.m[0][0], inertia.m[1][1], inertia.m[2][2]);
+    b->rock_mass_kg = mass;
+    b->rock_inertia = moments;
     const BodyId id = impl_->insert(std::move(b), mass, moments, btTransform(to_bt(rotation), to_bt(position_m)));
     btRigidBody* body = impl_->bodies.back()->body.get();
     body->setLinearVelocity(to_bt(velocity));
@@ -229,6 +231,7 @@ double RigidWorld::mass_kg(BodyId id) const
 {
     const Impl::Body& b = impl_->body(id, "mass_kg");
     if (b.multibody) return b.link < 0 ? b.multibody->getBaseMass() : b.multibody->getLinkMass(b.link);
+    if (b.is_rock()) return b.mass();
     return b.body->getInvMass() > 0.0 ? 1.0 / b.body->getInvMass() : 0.0;
 }
 
@@ -305,6 +308,30 @@ void RigidWorld::part_pose(BodyId id, Mat3& rotation, Vec3& origin_m) const
     rotation = from_bt(t.getBasis());
     origin_m = from_bt(t.getOrigin());
 }
+
+void RigidWorld::set_frozen(BodyId id, bool frozen)
+{
+    Impl::Body& b = impl_->body(id, "set_frozen");
+    if (!b.is_rock()) throw InputError(concat("set_frozen: '", b.name, "' is not a rock"));
+    if (b.frozen == frozen) return;
+    b.frozen = frozen;
+    btRigidBody& r = *b.body;
+    // at rest either way: a frozen rock is a fixed body (no integration, no solver rows against other fixed
+    // bodies), and one let go starts from rest
+    const btVector3 zero(0.0, 0.0, 0.0);
+    r.setLinearVelocity(zero);
+    r.setAngularVelocity(zero);
+    r.setInterpolationLinearVelocity(zero);
+    r.setInterpolationAngularVelocity(zero);
+    r.clearForces();
+    if (frozen)
+        r.setMassProps(0.0, zero);
+    else
+        r.setMassProps(b.rock_mass_kg, b.rock_inertia);
+    r.updateInertiaTensor();
+}
+
+bool RigidWorld::frozen(BodyId id) const { return impl_->body(id, "frozen").frozen; }
 
 bool RigidWorld::is_dynamic(BodyId id) const
 {
@@ -400,6 +427,9 @@ void RigidWorld::write_state(StateWriter& out) const
             write_transform(out, b->previous_pose);
         }
     }
+    std::vector<std::uint8_t> frozen;
+    for (const auto& b : w.bodies) frozen.push_back(b->frozen ? 1 : 0);
+    out.array(frozen);
     out.array(w.contact_force);
     out.array(as_vec3s(w.velocity_before));
     out.array(as_vec3s(w.spin_before));
@@ -433,6 +463,22 @@ void RigidWorld::read_state(StateReader& in)
             b->body->setInterpolationAngularVelocity(omega);
         } else {
             b->previous_pose = read_transform(in);
+        }
+    }
+    std::vector<std::uint8_t> frozen;
+    in.array(frozen);
+    if (frozen.size() != w.bodies.size()) in.fail("a frozen flag for each rigid body");
+    for (std::size_t k = 0; k < frozen.size(); ++k) {
+        if (frozen[k] > 1 || (frozen[k] && !w.bodies[k]->is_rock()))
+            in.fail(concat("rigid body '", w.bodies[k]->name, "' frozen; only rocks can be"));
+        if (frozen[k] != (w.bodies[k]->frozen ? 1 : 0)) {
+            // the flag, with the pose and velocities read above (zero for a frozen rock)
+            const btVector3 v = w.bodies[k]->body->getLinearVelocity(), omega = w.bodies[k]->body->getAngularVelocity();
+            set_frozen(static_cast<BodyId>(k), frozen[k] != 0);
+            w.bodies[k]->body->setLinearVelocity(v);
+            w.bodies[k]->body->setAngularVelocity(omega);
+            w.bodies[k]->body->setInterpolationLinearVelocity(v);
+            w.bodies[k]->body->setInterpolationAngularVelocity(omega);
         }
     }
     in.array(w.contact_force);
@@ -508,7 +554,7 @@ Vec3 RigidWorld::linear_momentum_kg_m_per_s() const
 {
     Vec3 p;
     for (const auto& b : impl_->bodies)
-        if (b->is_rock()) p += from_bt(b->body->getLinearVelocity()) * (1.0 / b->body->getInvMass());
+        if (b->is_rock() && !b->frozen) p += from_bt(b->body->getLinearVelocity()) * (1.0 / b->body->getInvMass());
     return p;
 }
 
@@ -516,7 +562,7 @@ Vec3 RigidWorld::angular_momentum_kg_m2_per_s() const
 {
     Vec3 l;
     for (const auto& b : impl_->bodies) {
-        if (!b->is_rock()) continue;
+        if (!b->is_rock() || b->frozen) continue;  // a frozen rock is at rest
         const btRigidBody* body = b->body.get();
         const btMatrix3x3& basis = body->getWorldTransform().getBasis();
         const btVector3 local_w = basis.transpose() * body->getAngularVelocity();
@@ -533,7 +579,7 @@ double RigidWorld::kinetic_energy_J() const
 {
     double e = 0.0;
     for (const auto& b : impl_->bodies) {
-        if (!b->is_rock()) continue;
+        if (!b->is_rock() || b->frozen) continue;
         const btRigidBody* body = b->body.get();
         const btVector3 v = body->getLinearVelocity(), w = body->getAngularVelocity();
         const btVector3 local_w = body->getWorldTransform().getBasis().transpose() * w;

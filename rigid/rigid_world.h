@@ -108,8 +108,13 @@ public:
     /// Pose of the frame the body's shape was given in (x_world = R x_part + origin): a rock's principal
     /// frame at its centroid, a mesh's or plate set's own frame, the dipper's and door's part frames.
     void part_pose(BodyId body, Mat3& rotation, Vec3& origin_m) const;
-    /// True for bodies that move under forces (rocks, the shovel's dipper and door).
+    /// True for bodies that move under forces (rocks, the shovel's dipper and door; a frozen rock too).
     bool is_dynamic(BodyId body) const;
+    /// Freezes a rock in place or lets it go: a frozen rock is a fixed body, at rest, that other bodies meet as
+    /// they meet the ground, and its contacts with the ground and other frozen rocks are not searched or solved
+    /// (their manifolds are kept for when it is let go). Forces applied to it are ignored; it starts from rest.
+    void set_frozen(BodyId rock, bool frozen);
+    bool frozen(BodyId body) const;
 
     // ---- the rope shovel (one per world)
     struct ShovelParts {

@@ -11,6 +11,7 @@ std::unique_ptr<coupling::CoSimulation> build_co_simulation(const Scenario& s, s
     coupling::CoSimulationSettings settings;
     settings.coupling = s.coupling;
     settings.rock_pairs = s.rock_pairs;
+    settings.dynamic_domain = s.dynamic_domain;
     for (const FillSpec& f : s.fills) settings.rocks = settings.rocks || !f.rocks.empty();
     std::unique_ptr<coupling::CoSimulation> sim;
     try {

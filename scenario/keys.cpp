@@ -109,6 +109,11 @@ const std::vector<KeySpec>& scenario_keys()
         {"coupling.substeps", "integer", std::to_string(coupling::kDefaultSubsteps), "DEM steps per rigid-body step (docs/coupling.md)"},
         {"coupling.runaway_guard", "boolean", coupling::CouplingSettings{}.runaway_guard ? "true" : "false", "one DEM step per rigid-body step for a while when a rock runs away (docs/coupling.md)"},
 
+        {"dynamic_domain", "map", "none", "freeze spheres and rocks at rest away from the machine and moving material (docs/coupling.md); none: every body moves"},
+        {"dynamic_domain.margin_m", "number", "1.0", "how far from anything moving a body must be to freeze (cells this wide)"},
+        {"dynamic_domain.rest_speed_m_per_s", "number", "0.01", "at rest: centre speed plus spin times radius at most this"},
+        {"dynamic_domain.rest_time_s", "number", "0.2", "at rest this long before it freezes"},
+
         {"shovel", "map", "none", "the rope shovel (docs/machine.md), driven by motion curves"},
         {"shovel.position_m", "vector3", "[0, 0, 0]", "machine origin: on the ground, on the swing axis"},
         {"shovel.heading_deg", "number", "0", "turn of the machine about z; 0 digs towards +x"},

@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "dipper-checkpoint 5";
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 6";
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int signal) { g_signal = signal; }
@@ -326,6 +326,7 @@ private:
                 csv_ << ",bucket_mass_kg,fill_factor,crowd_force_N,hoist_force_N,dig_force_N,interface_force_N,interface_force_without_lip_N,swing_deg,door_deg,"
                         "handle_angle_deg,crowd_extension_m,tooth_tip_x_m,tooth_tip_y_m,tooth_tip_z_m";
             for (const coupling::WearPart& w : sim_->wear()) csv_ << ",wear_" << w.part << "_m3";
+            if (scenario_.dynamic_domain.enabled) csv_ << ",frozen_spheres,frozen_rocks";
         }
         csv_ << ",wall_s_per_step,wall_clock_s\n";
         finish_writing(csv_, csv_path);
@@ -385,6 +386,8 @@ private:
                      << r.crowd_extension_m << ',' << r.tooth_tip_m.x << ',' << r.tooth_tip_m.y << ',' << r.tooth_tip_m.z;
             }
             for (const coupling::WearPart& part : sim_->wear()) csv_ << ',' << part.surface->total_volume_m3();
+            if (scenario_.dynamic_domain.enabled)
+                csv_ << ',' << sim_->dynamic_domain().frozen_spheres() << ',' << sim_->dynamic_domain().frozen_rocks();
         }
         const double now = wall_seconds_now();
         const std::uint64_t steps = w.step_count() - row_step_;

@@ -620,6 +620,18 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     if (substeps < 1 || substeps > 100) coupling.fail("substeps", concat(substeps), "a whole number of DEM steps per rigid step, 1 to 100");
     s.coupling.substeps = static_cast<int>(substeps);
     s.coupling.runaway_guard = coupling.boolean("runaway_guard");
+    if (top.has("dynamic_domain")) {
+        const MapReader d = top.map("dynamic_domain");
+        coupling::DynamicDomainSettings& dd = s.dynamic_domain;
+        dd.enabled = true;
+        dd.margin_m = d.number("margin_m");
+        dd.rest_speed_m_per_s = d.number("rest_speed_m_per_s");
+        dd.rest_time_s = d.number("rest_time_s");
+        if (!(dd.margin_m > 0.0) || dd.margin_m > 1e3) d.fail("margin_m", concat(dd.margin_m), "a distance > 0 and at most 1000 m");
+        if (!(dd.rest_speed_m_per_s > 0.0) || dd.rest_speed_m_per_s > 1e3)
+            d.fail("rest_speed_m_per_s", concat(dd.rest_speed_m_per_s), "a speed > 0 and at most 1000 m/s");
+        if (!(dd.rest_time_s >= 0.0) || dd.rest_time_s > 1e6) d.fail("rest_time_s", concat(dd.rest_time_s), "a time >= 0 and at most 10^6 s");
+    }
     if (top.has("shovel")) s.shovel = read_shovel(s, top.map("shovel"));
     for (const MapReader& w : top.maps("wear")) {
         WearSpec spec;
@@ -726,6 +738,9 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
                 throw InputError(concat(s.source, ": meshes[", k, "].removed_at_s: walls are removed for spheres only; this scenario has "
                                         "rocks, the shovel, wear surfaces or a pile, whose walls cannot be removed"));
     }
+    if (s.dynamic_domain.enabled && !s.uses_coupling())
+        throw InputError(concat(s.source, ": dynamic_domain: it freezes bodies of the co-simulation; this scenario has no rocks, "
+                                "shovel, wear surface or pile (a bed of spheres alone runs without it)"));
     return s;
 }
 

@@ -149,6 +149,7 @@ struct Scenario {
     std::optional<ReposeProbe> repose;
     OutputSpec output;
     coupling::CouplingSettings coupling;  ///< coupling.substeps, coupling.runaway_guard
+    coupling::DynamicDomainSettings dynamic_domain;  ///< dynamic_domain: enabled where the section is given
     std::optional<ShovelSpec> shovel;
     std::vector<WearSpec> wear;
 

@@ -37,6 +37,14 @@ public:
     void watch(const btCollisionObjectArray* objects) { objects_ = objects; }
 
     void dispatchAllCollisionPairs(btOverlappingPairCache* pairs, const btDispatcherInfo& info, btDispatcher* dispatcher) override;
+    /// Bullet's test, and two fixed bodies never: a rock frozen in place (RigidWorld::set_frozen) keeps its pairs
+    /// with the ground and other frozen rocks, manifolds included, untouched until it is let go.
+    bool needsCollision(const btCollisionObject* body0, const btCollisionObject* body1) override
+    {
+        auto fixed = [](const btCollisionObject* o) { return o->isStaticObject() && !o->isKinematicObject(); };
+        if (fixed(body0) && fixed(body1)) return false;
+        return btCollisionDispatcher::needsCollision(body0, body1);
+    }
 
     // the algorithm pool is shared: locked while pass 1 runs (a hull against a mesh makes one per triangle)
     void* allocateCollisionAlgorithm(int size) override;

@@ -82,7 +82,13 @@ struct RigidWorld::Impl {
         std::uint64_t touching_step = 0;
 
         btCollisionObject* object() const { return body ? static_cast<btCollisionObject*>(body.get()) : link_collider.get(); }
-        bool is_rock() const { return body && body->getInvMass() > 0.0; }
+        double rock_mass_kg = 0.0;  ///< a rock's mass and principal moments, kept while it is frozen
+        btVector3 rock_inertia{0.0, 0.0, 0.0};
+        bool frozen = false;        ///< a rock held as a fixed body (RigidWorld::set_frozen)
+
+        bool is_rock() const { return body && (body->getInvMass() > 0.0 || frozen); }
+        /// A rock's mass: Bullet's, or the one kept while it is frozen.
+        double mass() const { return frozen ? rock_mass_kg : 1.0 / body->getInvMass(); }
         /// Velocity of the material point of this body that is at `point` now.
         btVector3 velocity_at(const btVector3& point, double dt) const
         {

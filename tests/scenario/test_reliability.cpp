@@ -307,3 +307,63 @@ output: {vtk_interval_s: 0, csv_interval_s: 0.05}
                                                                                      "sizes: [{radius_m: 0.1, mass_fraction: 0.5}], rocks: [{size_m: 0.3, mass_fraction: 0.5}]}\n")),
                Contains("planes[5].removed_at_s: walls are removed for spheres only"));
 }
+
+TEST_CASE("a run with a dynamic domain freezes its settled bed, and a resume keeps the bits", "[scenario][dynamic_domain][unit]")
+{
+    // a box of spheres that settles; saving a pile makes it a co-simulation, whose bodies the dynamic domain freezes
+    const std::string text = R"(dipper_scenario: 1
+name: frozen_bed
+seed: 5
+threads: 1
+time: {duration_s: 3.0}
+planes:
+  - {name: floor, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+  - {name: x0, point_m: [0, 0, 0], normal: [1, 0, 0], material: steel}
+  - {name: x1, point_m: [1, 0, 0], normal: [-1, 0, 0], material: steel}
+  - {name: y0, point_m: [0, 0, 0], normal: [0, 1, 0], material: steel}
+  - {name: y1, point_m: [0, 1, 0], normal: [0, -1, 0], material: steel}
+fills:
+  - {mass_kg: 450, box: {min_m: [0, 0, 0], max_m: [1, 1, 0.8]}, sizes: [{radius_m: 0.1, mass_fraction: 1.0}]}
+dynamic_domain: {margin_m: 0.3, rest_speed_m_per_s: 0.02, rest_time_s: 0.1}
+output: {vtk_interval_s: 0, csv_interval_s: 0.05, pile_file: pile.txt}
+)";
+    const fs::path dir = fs::temp_directory_path() / "dipper_frozen_bed";
+    fs::remove_all(dir);
+    RunOptions quiet;
+    quiet.progress = false;
+    const Scenario s = parse_scenario(text, "frozen_bed.yaml", ".");
+    REQUIRE(s.dynamic_domain.enabled);
+    REQUIRE(run_scenario(s, (dir / "whole").string(), quiet).status == RunStatus::completed);
+    // the last row: most of the bed frozen by the end (it comes to rest from 1.5 s on; a few spheres roll on between
+    // the frictionless side walls, 18 of 29 frozen)
+    const std::string csv = test::read_text_file((dir / "whole" / "probes.csv").string());
+    const std::string header = csv.substr(0, csv.find('\n'));
+    REQUIRE_THAT(header, Contains(",frozen_spheres,frozen_rocks,"));
+    const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
+    std::stringstream cells(last), names(header);
+    std::string cell, name, particles, frozen;
+    while (std::getline(names, name, ',') && std::getline(cells, cell, ',')) {
+        if (name == "particles") particles = cell;
+        if (name == "frozen_spheres") frozen = cell;
+    }
+    REQUIRE(!particles.empty());
+    REQUIRE(!frozen.empty());
+    CHECK(2 * std::stoi(frozen) >= std::stoi(particles));
+    // stopped while the bed freezes and after, resumed: the uninterrupted run's state
+    const std::string summary = test::read_text_file((dir / "whole" / "summary.json").string());
+    const auto hash = [](const std::string& j) { return j.substr(j.find("\"state_hash\""), 32); };
+    for (const double stop : {1.0, 2.0}) {  // before and after the bed began to freeze
+        RunOptions o = quiet;
+        o.stop_after_s = stop;
+        const std::string legs = (dir / concat("legs_", stop)).string();
+        REQUIRE(run_scenario(s, legs, o).status == RunStatus::interrupted);
+        REQUIRE(resume_run(legs, quiet).status == RunStatus::completed);
+        CHECK(hash(test::read_text_file(legs + "/summary.json")) == hash(summary));
+    }
+    // a scenario that is no co-simulation has nothing for it to freeze
+    CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex(", pile_file: pile.txt"), "")),
+               Contains("dynamic_domain: it freezes bodies of the co-simulation"));
+    CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex("margin_m: 0.3"), "margin_m: -1")),
+               Contains("dynamic_domain.margin_m"));
+    fs::remove_all(dir);
+}

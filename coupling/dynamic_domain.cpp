@@ -1,0 +1,193 @@
+#include "coupling/dynamic_domain.h"
+
+#include "core/errors.h"
+#include "coupling/coupled_world.h"
+#include "dem/world.h"
+#include "rigid/rigid_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dipper::coupling {
+
+namespace {
+/// The grid holds at most this many cells; bodies spread wider get wider cells (a larger margin, never smaller).
+constexpr double kMaxCells = 1 << 24;
+}  // namespace
+
+DynamicDomain::DynamicDomain(DynamicDomainSettings settings) : settings_(settings)
+{
+    require_positive(settings_.margin_m, "margin_m", "dynamic domain");
+    require_positive(settings_.rest_speed_m_per_s, "rest_speed_m_per_s", "dynamic domain");
+    if (!(settings_.rest_time_s >= 0.0) || !std::isfinite(settings_.rest_time_s))
+        throw InputError(concat("dynamic domain: rest_time_s is ", settings_.rest_time_s, "; expected a finite value >= 0"));
+}
+
+std::size_t DynamicDomain::cell_index(const Vec3& p) const
+{
+    std::size_t c[3];
+    for (int a = 0; a < 3; ++a)
+        c[a] = static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor((p[a] - lo_m_[a]) / cell_m_)), 0, dims_[a] - 1));
+    return (c[2] * static_cast<std::size_t>(dims_[1]) + c[1]) * static_cast<std::size_t>(dims_[0]) + c[0];
+}
+
+template <class Visit>
+bool DynamicDomain::any_cell(const Vec3& lo, const Vec3& hi, Visit visit) const
+{
+    int a0[3], a1[3];
+    for (int a = 0; a < 3; ++a) {
+        // boxes beyond the grid touch its border cells (the grid holds every body)
+        a0[a] = std::clamp(static_cast<int>(std::floor((lo[a] - lo_m_[a]) / cell_m_)), 0, dims_[a] - 1);
+        a1[a] = std::clamp(static_cast<int>(std::floor((hi[a] - lo_m_[a]) / cell_m_)), 0, dims_[a] - 1);
+    }
+    for (int z = a0[2]; z <= a1[2]; ++z)
+        for (int y = a0[1]; y <= a1[1]; ++y)
+            for (int x = a0[0]; x <= a1[0]; ++x)
+                if (visit((static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x)) return true;
+    return false;
+}
+
+void DynamicDomain::mark(const Vec3& lo, const Vec3& hi)
+{
+    any_cell(lo, hi, [this](std::size_t c) {
+        hot_[c] = 1;
+        return false;
+    });
+}
+
+bool DynamicDomain::near(const Vec3& lo, const Vec3& hi) const
+{
+    return any_cell(lo, hi, [this](std::size_t c) { return near_[c] != 0; });
+}
+
+void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
+{
+    if (!settings_.enabled) return;
+    dem::World& dem = coupled.dem();
+    rigid::RigidWorld& rigid = coupled.rigid();
+    const dem::ParticleStore& p = dem.particles();
+    const std::size_t n = p.size();
+    const std::vector<RockRecord>& rocks = coupled.rocks();
+    const double rest_speed = settings_.rest_speed_m_per_s;
+
+    // each rock's DEM wall, bounding sphere and speed
+    struct RockNow {
+        int wall;
+        Vec3 centre;
+        double radius, speed;
+    };
+    std::vector<RockNow> rock_now(rocks.size());
+    for (std::size_t k = 0; k < rocks.size(); ++k) {
+        const int wall = coupled.body(coupled.index_of(rocks[k].body)).wall;
+        const dem::MeshWall& m = dem.mesh_wall(wall);
+        const rigid::BodyState s = rigid.state(rocks[k].body);
+        rock_now[k] = {wall, m.bound_centre_world_m(), m.bound_radius_m(),
+                       norm(s.velocity_m_per_s) + norm(s.angular_velocity_rad_per_s) * m.bound_radius_m()};
+    }
+    if (n == 0 && rocks.empty()) return;
+
+    // 1. the grid over every body, cells margin_m wide
+    const double inf = std::numeric_limits<double>::infinity();
+    Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+    auto grow = [&](const Vec3& a, const Vec3& b) {
+        lo = {std::min(lo.x, a.x), std::min(lo.y, a.y), std::min(lo.z, a.z)};
+        hi = {std::max(hi.x, b.x), std::max(hi.y, b.y), std::max(hi.z, b.z)};
+    };
+    for (const Vec3& x : p.position_m) grow(x, x);
+    for (const RockNow& r : rock_now) grow(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
+    lo_m_ = lo;
+    cell_m_ = settings_.margin_m;
+    for (;;) {
+        double total = 1.0;
+        for (int a = 0; a < 3; ++a) total *= std::floor((hi[a] - lo[a]) / cell_m_) + 1.0;
+        if (total <= kMaxCells) break;
+        cell_m_ *= std::max(1.25, std::cbrt(total / kMaxCells));
+    }
+    for (int a = 0; a < 3; ++a) dims_[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell_m_)) + 1;
+    const std::size_t cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+    hot_.assign(cells, 0);
+
+    // 2. the cells with something moving: spheres and rocks faster than the rest speed, moving walls (a machine part,
+    //    a gate) over their bounding sphere
+    auto sphere_speed = [&](std::size_t i) {
+        return norm(p.velocity_m_per_s[i]) + norm(p.angular_velocity_rad_per_s[i]) * p.radius_m[i];
+    };
+    for (std::size_t i = 0; i < n; ++i)
+        if (!p.frozen[i] && sphere_speed(i) > rest_speed) hot_[cell_index(p.position_m[i])] = 1;
+    for (const RockNow& r : rock_now)
+        if (r.speed > rest_speed) mark(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
+    for (std::size_t w = 0; w < dem.wall_count(); ++w) {
+        const int wall = static_cast<int>(w);
+        if (!dem.is_mesh(wall) || dem.wall_removed(wall)) continue;
+        const dem::MeshWall& m = dem.mesh_wall(wall);
+        if (m.convex()) continue;  // rocks, above
+        if (m.velocity_at(m.reference_point_m()) == Vec3{} && m.angular_velocity_rad_per_s() == Vec3{}) continue;
+        const Vec3 c = m.bound_centre_world_m();
+        const double r = m.bound_radius_m();
+        mark(c - Vec3{r, r, r}, c + Vec3{r, r, r});
+    }
+
+    // 3. near: a hot cell and the 26 around it
+    near_.assign(cells, 0);
+    for (int z = 0; z < dims_[2]; ++z)
+        for (int y = 0; y < dims_[1]; ++y)
+            for (int x = 0; x < dims_[0]; ++x) {
+                if (!hot_[(static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x]) continue;
+                for (int zz = std::max(0, z - 1); zz <= std::min(dims_[2] - 1, z + 1); ++zz)
+                    for (int yy = std::max(0, y - 1); yy <= std::min(dims_[1] - 1, y + 1); ++yy)
+                        for (int xx = std::max(0, x - 1); xx <= std::min(dims_[0] - 1, x + 1); ++xx)
+                            near_[(static_cast<std::size_t>(zz) * dims_[1] + yy) * dims_[0] + xx] = 1;
+            }
+
+    // 4. each body's time at rest; frozen once at rest for rest_time_s and not near anything moving, let go when
+    //    something moving comes near
+    std::uint32_t max_id = 0;
+    for (std::uint32_t id : p.id) max_id = std::max(max_id, id);
+    if (n > 0 && sphere_rest_s_.size() <= max_id) sphere_rest_s_.resize(static_cast<std::size_t>(max_id) + 1, 0.0);
+    frozen_spheres_ = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        double& rest = sphere_rest_s_[p.id[i]];
+        rest = sphere_speed(i) <= rest_speed ? rest + interval_s : 0.0;
+        const bool freeze = rest >= settings_.rest_time_s && !near_[cell_index(p.position_m[i])];
+        if (freeze != (p.frozen[i] != 0)) dem.set_frozen(i, freeze);
+        frozen_spheres_ += freeze ? 1 : 0;
+    }
+    rock_rest_s_.resize(rocks.size(), 0.0);
+    frozen_rocks_ = 0;
+    for (std::size_t k = 0; k < rocks.size(); ++k) {
+        const RockNow& r = rock_now[k];
+        double& rest = rock_rest_s_[k];
+        rest = r.speed <= rest_speed ? rest + interval_s : 0.0;
+        const bool freeze = rest >= settings_.rest_time_s &&
+                            !near(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
+        if (freeze != rigid.frozen(rocks[k].body)) {
+            rigid.set_frozen(rocks[k].body, freeze);
+            dem.set_wall_frozen(r.wall, freeze);
+        }
+        frozen_rocks_ += freeze ? 1 : 0;
+    }
+}
+
+void DynamicDomain::write_state(StateWriter& out) const
+{
+    out.tag("dynamic-domain");
+    out.array(sphere_rest_s_);
+    out.array(rock_rest_s_);
+    out.value<std::uint64_t>(frozen_spheres_);
+    out.value<std::uint64_t>(frozen_rocks_);
+}
+
+void DynamicDomain::read_state(StateReader& in)
+{
+    in.tag("dynamic-domain");
+    in.array(sphere_rest_s_);
+    in.array(rock_rest_s_);
+    for (const auto* v : {&sphere_rest_s_, &rock_rest_s_})
+        for (double t : *v)
+            if (!(t >= 0.0) || !std::isfinite(t)) in.fail(concat("a time at rest of ", t, " s; expected a finite value >= 0"));
+    frozen_spheres_ = in.value<std::uint64_t>();
+    frozen_rocks_ = in.value<std::uint64_t>();
+}
+
+}  // namespace dipper::coupling
