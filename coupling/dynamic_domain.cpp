@@ -108,8 +108,8 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
     hot_.assign(cells, 0);
 
-    // 2. the cells with something moving: spheres and rocks faster than the rest speed, moving walls (a machine part,
-    //    a gate) over their bounding sphere
+    // 2. the cells with something moving: spheres and rocks faster than the rest speed, walls that move or may move
+    //    (a machine part, a gate) over their bounding sphere
     auto sphere_speed = [&](std::size_t i) {
         return norm(p.velocity_m_per_s[i]) + norm(p.angular_velocity_rad_per_s[i]) * p.radius_m[i];
     };
@@ -122,7 +122,10 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
         if (!dem.is_mesh(wall) || dem.wall_removed(wall)) continue;
         const dem::MeshWall& m = dem.mesh_wall(wall);
         if (m.convex()) continue;  // rocks, above
-        if (m.velocity_at(m.reference_point_m()) == Vec3{} && m.angular_velocity_rad_per_s() == Vec3{}) continue;
+        // a machine part (a body behind it) or a wall with a motion counts while it pauses too: what it holds must not
+        // freeze and be pushed frozen when it starts again
+        const bool may_move = m.mass_kg() > 0.0 || m.motion().has_value();
+        if (!may_move && m.velocity_at(m.reference_point_m()) == Vec3{} && m.angular_velocity_rad_per_s() == Vec3{}) continue;
         const Vec3 c = m.bound_centre_world_m();
         const double r = m.bound_radius_m();
         mark(c - Vec3{r, r, r}, c + Vec3{r, r, r});

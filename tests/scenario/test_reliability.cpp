@@ -248,6 +248,24 @@ TEST_CASE("a pile dipper settled and saved loads again with the overlaps it was 
     CHECK(run_scenario(load_scenario((dir / "reuse.yaml").string()), (dir / "reused").string(), quiet).status == RunStatus::completed);
 }
 
+namespace {
+/// The "state_hash" entry of a summary.json text.
+std::string hash(const std::string& summary_json) { return summary_json.substr(summary_json.find("\"state_hash\""), 32); }
+
+/// The state hash of a run of `s` stopped at stop_s and resumed to its end, in dir/legs_<stop_s>.
+std::string resumed_hash(const Scenario& s, const fs::path& dir, double stop_s)
+{
+    RunOptions quiet;
+    quiet.progress = false;
+    RunOptions o = quiet;
+    o.stop_after_s = stop_s;
+    const std::string legs = (dir / concat("legs_", stop_s)).string();
+    REQUIRE(run_scenario(s, legs, o).status == RunStatus::interrupted);
+    REQUIRE(resume_run(legs, quiet).status == RunStatus::completed);
+    return hash(test::read_text_file(legs + "/summary.json"));
+}
+}  // namespace
+
 TEST_CASE("a gate removed at its time lets a box empty, and a resume across the removal keeps the bits", "[scenario][walls][unit]")
 {
     const std::string text = R"(dipper_scenario: 1
@@ -292,16 +310,7 @@ output: {vtk_interval_s: 0, csv_interval_s: 0.05}
     const std::string summary = test::read_text_file((dir / "whole" / "summary.json").string());
     CHECK_THAT(summary, Contains("\"region_mass_kg\": {\"box\": 0}"));
     // stopped before and after the removal, resumed: the uninterrupted run's state
-    for (const double stop : {0.2, 0.5}) {
-        RunOptions o = quiet;
-        o.stop_after_s = stop;
-        const std::string legs = (dir / concat("legs_", stop)).string();
-        REQUIRE(run_scenario(s, legs, o).status == RunStatus::interrupted);
-        REQUIRE(resume_run(legs, quiet).status == RunStatus::completed);
-        const std::string resumed = test::read_text_file(legs + "/summary.json");
-        const auto hash = [](const std::string& j) { return j.substr(j.find("\"state_hash\""), 32); };
-        CHECK(hash(resumed) == hash(summary));
-    }
+    for (const double stop : {0.2, 0.5}) CHECK(resumed_hash(s, dir, stop) == hash(summary));
     // not with rocks or the shovel: Bullet keeps its copy of the walls
     CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex("fills:\n.*\n"), "fills:\n  - {mass_kg: 300, box: {min_m: [0, 0, 0], max_m: [1, 1, 0.8]}, "
                                                                                      "sizes: [{radius_m: 0.1, mass_fraction: 0.5}], rocks: [{size_m: 0.3, mass_fraction: 0.5}]}\n")),
@@ -351,15 +360,7 @@ output: {vtk_interval_s: 0, csv_interval_s: 0.05, pile_file: pile.txt}
     CHECK(2 * std::stoi(frozen) >= std::stoi(particles));
     // stopped while the bed freezes and after, resumed: the uninterrupted run's state
     const std::string summary = test::read_text_file((dir / "whole" / "summary.json").string());
-    const auto hash = [](const std::string& j) { return j.substr(j.find("\"state_hash\""), 32); };
-    for (const double stop : {1.0, 2.0}) {  // before and after the bed began to freeze
-        RunOptions o = quiet;
-        o.stop_after_s = stop;
-        const std::string legs = (dir / concat("legs_", stop)).string();
-        REQUIRE(run_scenario(s, legs, o).status == RunStatus::interrupted);
-        REQUIRE(resume_run(legs, quiet).status == RunStatus::completed);
-        CHECK(hash(test::read_text_file(legs + "/summary.json")) == hash(summary));
-    }
+    for (const double stop : {1.0, 2.0}) CHECK(resumed_hash(s, dir, stop) == hash(summary));  // before and after it began to freeze
     // a scenario that is no co-simulation has nothing for it to freeze
     CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex(", pile_file: pile.txt"), "")),
                Contains("dynamic_domain: it freezes bodies of the co-simulation"));
