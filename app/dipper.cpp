@@ -266,7 +266,7 @@ int main(int argc, char** argv)
                     continue;
                 }
                 const Scenario s = load_scenario(file);
-                check_scenario(s);
+                for (const std::string& w : check_scenario(s)) std::fprintf(stderr, "warning: %s\n", w.c_str());
                 double fill = 0.0, pour = 0.0;
                 for (const auto& f : s.fills) fill += f.mass_kg;
                 for (const auto& p : s.pours) pour += p.mass_kg;

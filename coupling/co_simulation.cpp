@@ -120,6 +120,12 @@ CoSimulation::CoSimulation(std::unique_ptr<dem::World> dem, CoSimulationSettings
 
 CoSimulation::~CoSimulation() = default;
 
+std::vector<rigid::PartPath> CoSimulation::shovel_path(double max_move_m) const
+{
+    if (!has_shovel()) return {};
+    return rigid::shovel_path(rigid::ShovelGeometry{}, dipper_, *motion_, shovel_position_m_, shovel_heading_deg_, max_move_m);
+}
+
 void CoSimulation::add_shovel(const ShovelSettings& sh)
 {
     if (has_shovel()) throw InputError("add_shovel: the co-simulation has a rope shovel already");
@@ -158,6 +164,8 @@ void CoSimulation::add_shovel(const ShovelSettings& sh)
         part_bounds_[static_cast<std::size_t>(part)] = {centre, radius};
     }
     motion_ = std::make_unique<rigid::MotionCurves>(motion);
+    shovel_position_m_ = sh.position_m;
+    shovel_heading_deg_ = sh.heading_deg;
     const rigid::RigidWorld::ShovelParts parts =
         rigid_->add_rope_shovel(dipper_, geometry, std::move(motion), rigid_->material_index("bucket"), sh.position_m, sh.heading_deg);
     dipper_body_ = parts.dipper;

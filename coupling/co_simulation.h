@@ -9,6 +9,7 @@
 #include "meshes/machine_geometry.h"
 #include "meshes/triangle_locator.h"
 #include "rigid/motion_curves.h"
+#include "rigid/machine_path.h"
 #include "rigid/rigid_world.h"
 #include "wear/wear_surface.h"
 
@@ -133,6 +134,9 @@ public:
     rigid::BodyId dipper_body() const { return dipper_body_; }
     rigid::BodyId door_body() const { return door_body_; }
     const meshes::Dipper& dipper() const { return dipper_; }
+    /// The shovel's crawlers, upper body, handle, dipper and door posed along its whole cycle by its curves alone
+    /// (rigid::shovel_path: no point moves more than max_move_m between two samples); empty without a shovel.
+    std::vector<rigid::PartPath> shovel_path(double max_move_m = 0.05) const;
     const rigid::ShovelReading& reading() const;
     /// Resultant force of the spheres and rocks on dipper and door in the last step, N (0 without a shovel).
     Vec3 interface_force_N() const;
@@ -200,6 +204,8 @@ private:
     };
     std::array<Sphere, 2> part_bounds_{};  ///< around the dipper's and the door's plates, in their frames
     std::unique_ptr<rigid::MotionCurves> motion_;  ///< the shovel's curves (the dig phase is read from them)
+    Vec3 shovel_position_m_;
+    double shovel_heading_deg_ = 0.0;
     double bulk_density_ = 1903.0;
     rigid::BodyId dipper_body_ = -1, door_body_ = -1;
     int dipper_wall_ = -1, door_wall_ = -1;

@@ -220,7 +220,7 @@ PYBIND11_MODULE(_dipper, m)
         .def_readonly("threads", &Scenario::threads)
         .def_readonly("duration_s", &Scenario::duration_s)
         .def_readonly("step_s", &Scenario::step_s)
-        .def("check", [](const Scenario& s) { scenario::check_scenario(s); });
+        .def("check", [](const Scenario& s) { return scenario::check_scenario(s); });
 
     m.def("load_scenario",
           [](const std::string& path, const std::vector<std::pair<std::string, std::string>>& values) {

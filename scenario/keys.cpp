@@ -51,6 +51,7 @@ const std::vector<KeySpec>& scenario_keys()
         {"planes[].normal", "vector3", "required", "towards the side the particles are on; normalised"},
         {"planes[].material", "string", "required", "surface material"},
         {"planes[].removed_at_s", "number", "none", "time from which no sphere touches the plane (a gate opened); spheres only, not with rocks or the shovel"},
+        {"planes[].material_only", "boolean", "false", "the plane only holds material (a slice's side): the shovel's path may cross it with a warning; else it stands for steel and a path into it is refused"},
 
         {"meshes", "list", "[]", "triangle-mesh walls from files (STL, OBJ, PLY) or generated machine parts"},
         {"meshes[].name", "string", "required", "unique wall name (used in outputs)"},
@@ -70,6 +71,7 @@ const std::vector<KeySpec>& scenario_keys()
         {"meshes[].motion.start_s", "number", "0", "the motion starts then (t in the formulas counts from it); before, the mesh rests at its t = 0 pose"},
         {"meshes[].motion.end_s", "number", "none", "the motion stops then and the mesh stays where it was brought"},
         {"meshes[].removed_at_s", "number", "none", "time from which no sphere touches the mesh (a plug pulled); spheres only, not with rocks or the shovel"},
+        {"meshes[].material_only", "boolean", "false", "the mesh only holds material: the shovel's path may cross it with a warning; else it stands for steel (the truck) and a path through it is refused"},
 
         {"pile", "string", "none",
          "a saved pile (output.pile_file of an earlier run), relative to this file: its spheres and rocks are placed at t = 0, "

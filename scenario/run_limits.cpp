@@ -83,7 +83,56 @@ void require_spheres_at_start(const Scenario& s, const dem::World& world)
                                    "more (each try draws a centre anywhere in the box) or set time.step_s"));
 }
 
-void check_scenario(const Scenario& s)
+std::vector<std::string> require_clear_path(const Scenario& s, const coupling::CoSimulation& sim)
+{
+    if (!sim.has_shovel()) return {};
+    // the walls as the DEM world holds them: the planes, then the meshes, in the scenario's order
+    std::vector<rigid::PathObstacle> walls;
+    std::vector<bool> material_only;
+    for (const PlaneSpec& p : s.planes) {
+        rigid::PathObstacle o;
+        o.name = p.name;
+        o.is_plane = true;
+        o.point_m = p.point_m;
+        o.normal = p.normal;
+        o.removed_at_s = p.removed_at_s;
+        walls.push_back(std::move(o));
+        material_only.push_back(p.material_only);
+    }
+    for (std::size_t k = 0; k < s.meshes.size(); ++k) {
+        const dem::MeshWall& wall = sim.dem().mesh_wall(static_cast<int>(s.planes.size() + k));
+        rigid::PathObstacle o;
+        o.name = s.meshes[k].name;
+        o.surface = wall.mesh();
+        if (wall.motion()) {
+            const dem::PrescribedMotion motion = *wall.motion();
+            o.pose = [motion](double t, Mat3& r, Vec3& x) { motion.pose(t, r, x); };
+        }
+        o.removed_at_s = s.meshes[k].removed_at_s;
+        walls.push_back(std::move(o));
+        material_only.push_back(s.meshes[k].material_only);
+    }
+    const std::vector<rigid::PartPath> path = sim.shovel_path();
+    std::vector<std::string> refused, warnings;
+    for (const rigid::PathCrossing& c : rigid::find_crossings(path, walls)) {
+        const std::size_t k = static_cast<std::size_t>(
+            std::find_if(walls.begin(), walls.end(), [&](const rigid::PathObstacle& o) { return o.name == c.obstacle; }) - walls.begin());
+        (material_only[k] ? warnings : refused).push_back(rigid::describe(c));
+    }
+    if (!refused.empty()) {
+        std::string text = concat(s.source, ": the shovel's cycle passes through walls that stand for steel (the machine does not stop "
+                                            "at walls, docs/limits.md):");
+        constexpr std::size_t kListed = 10;
+        for (std::size_t k = 0; k < refused.size() && k < kListed; ++k) text += "\n  " + refused[k];
+        if (refused.size() > kListed) text += concat("\n  and ", refused.size() - kListed, " more");
+        text += "\nmove the machine, the wall or the motion, or mark a wall that only holds material with material_only: true";
+        throw InputError(text);
+    }
+    for (std::string& w : warnings) w = concat(s.source, ": ", w, " (material_only: the machine passes through)");
+    return warnings;
+}
+
+std::vector<std::string> check_scenario(const Scenario& s)
 {
     std::unique_ptr<dem::World> own = build_world(s);  // mesh files are read and checked too
     dem::World* const world = own.get();
@@ -91,6 +140,8 @@ void check_scenario(const Scenario& s)
     // Bullet's side: walls rocks meet, the dipper's parameters, the motion file
     std::unique_ptr<coupling::CoSimulation> sim;
     if (s.uses_coupling()) sim = build_co_simulation(s, std::move(own));
+    std::vector<std::string> warnings;
+    if (sim) warnings = require_clear_path(s, *sim);
     // what the run places at t = 0 before its first step, where the step depends on it: the pours due at 0
     // when no fill or pile brings spheres (the same seeds as the run)
     const bool fills_bring_spheres = std::any_of(s.fills.begin(), s.fills.end(), [](const FillSpec& f) {
@@ -111,6 +162,7 @@ void check_scenario(const Scenario& s)
         throw InputError(concat(s.source, ": time.duration_s = ", s.duration_s, " s is ", s.duration_s / step, " steps of ", step,
                                 " s (", s.step_s > 0.0 ? "time.step_s" : "the default step of the smallest, stiffest sphere",
                                 "); a run takes at most ", kMaxSteps, " steps: check the radii, the Young's moduli and the pairs' C_norm"));
+    return warnings;
 }
 
 }  // namespace dipper::scenario

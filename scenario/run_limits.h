@@ -2,8 +2,12 @@
 // a time step, output intervals the step can keep, the memory and the step count a machine can hold.
 #pragma once
 
+#include "coupling/co_simulation.h"
 #include "dem/world.h"
 #include "scenario/scenario.h"
+
+#include <string>
+#include <vector>
 
 namespace dipper::scenario {
 
@@ -20,10 +24,15 @@ void require_run_fits(const Scenario& scenario, const dem::World& world);
 /// Throws an InputError naming the first pour if the world has no sphere once the fills and the pours due
 /// at t = 0 are placed and the scenario sets no time.step_s: the default step comes from the spheres.
 void require_spheres_at_start(const Scenario& scenario, const dem::World& world);
+/// The shovel's path against the scenario's planes and meshes (rigid::find_crossings): throws an InputError
+/// naming the part, the wall, the time and the depth of each place where a part would pass into a wall that
+/// stands for steel, and returns one warning for each crossing of a wall marked `material_only`. Nothing
+/// without a shovel.
+std::vector<std::string> require_clear_path(const Scenario& scenario, const coupling::CoSimulation& sim);
 /// What `dipper check` does past parsing: builds the world with its mesh files and Bullet's side, checks the
 /// material pairs, places the pours due at t = 0 where the time step depends on them, and checks the
-/// intervals against the step and the memory against the machine's; an InputError for what the run
-/// would refuse at its start.
-void check_scenario(const Scenario& scenario);
+/// intervals against the step and the memory against the machine's, and the shovel's path against the walls;
+/// an InputError for what the run would refuse at its start. Returns the warnings (require_clear_path).
+std::vector<std::string> check_scenario(const Scenario& scenario);
 
 }  // namespace dipper::scenario

@@ -122,6 +122,8 @@ public:
         }
         adopt(std::make_unique<Simulation>(scenario_));
         pile_ = model_->pile();
+        if (options_.progress)
+            for (const std::string& w : model_->warnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
         if (options_.progress && (pile_.spheres_left_out > 0 || pile_.rocks_left_out > 0))
             std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
                          scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);

@@ -522,6 +522,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         plane.normal = plane.normal * (1.0 / norm(plane.normal));
         plane.material = material_known(s, p, "material", true);
         plane.removed_at_s = removal_time(p);
+        plane.material_only = p.boolean("material_only");
         s.planes.push_back(plane);
     }
     for (const MapReader& m : top.maps("meshes")) {
@@ -564,6 +565,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
             mesh.motion = motion;
         }
         mesh.removed_at_s = removal_time(m);
+        mesh.material_only = m.boolean("material_only");
         s.meshes.push_back(mesh);
     }
     // wall names are unique across planes and meshes

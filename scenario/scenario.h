@@ -23,6 +23,7 @@ struct PlaneSpec {
     std::string name, material;
     Vec3 point_m, normal;
     double removed_at_s = std::numeric_limits<double>::infinity();  ///< from then on no sphere touches it
+    bool material_only = false;  ///< holds material only: the shovel's path may cross it (machine_crossings)
 };
 
 struct MeshSpec {
@@ -34,6 +35,7 @@ struct MeshSpec {
     Vec3 translate_m;
     std::optional<dem::PrescribedMotion> motion;
     double removed_at_s = std::numeric_limits<double>::infinity();  ///< from then on no sphere touches it
+    bool material_only = false;  ///< holds material only: the shovel's path may cross it (machine_crossings)
     std::string where;                 ///< file:line:col of the entry, for errors found when loading the mesh
 };
 

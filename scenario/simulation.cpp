@@ -10,6 +10,7 @@ Simulation::Simulation(Scenario scenario, int threads) : scenario_(std::move(sce
 {
     if (threads > 0) scenario_.threads = threads;
     build();
+    if (sim_) warnings_ = require_clear_path(scenario_, *sim_);  // before any particle: a cycle into steel is refused
     if (!scenario_.pile.empty()) {  // errors name file and line
         const coupling::CoSimulation& sim = *sim_;
         pile_ = coupling::load_state(sim_->coupled(), scenario_.pile, [&sim](const Vec3& c, double r) { return sim.clear_of_machine(c, r); });

@@ -20,7 +20,8 @@ class Simulation {
 public:
     /// The model at t = 0: the walls, the pile, the fills (spheres, then rocks clear of the machine), the wear
     /// surfaces and the pours due at t = 0, prepared for the first step. `threads` > 0 replaces the scenario's.
-    /// Refuses (InputError) what the run could not go through (require_run_fits, require_spheres_at_start).
+    /// Refuses (InputError) what the run could not go through (require_run_fits, require_spheres_at_start) and a
+    /// shovel whose cycle passes through steel (require_clear_path).
     explicit Simulation(Scenario scenario, int threads = 0);
     /// The model as a checkpoint saved it: `in` stands after the checkpoint's run header (checkpoint_header) and
     /// is left before the run's own outputs.
@@ -51,6 +52,8 @@ public:
     /// (a model read from a checkpoint has none: the run keeps it with its outputs).
     const coupling::LoadedState& pile() const { return pile_; }
     double time_s() const { return world_->time_s(); }
+    /// The shovel's crossings of walls marked material_only, found when this model was built at t = 0.
+    const std::vector<std::string>& warnings() const { return warnings_; }
 
     static constexpr std::uint64_t kPourEvery = 20;  ///< steps between pour insertions
 
@@ -64,6 +67,7 @@ private:
     std::unique_ptr<coupling::CoSimulation> sim_;
     std::vector<dem::Pourer> pourers_;
     coupling::LoadedState pile_;
+    std::vector<std::string> warnings_;
 };
 
 }  // namespace dipper::scenario

@@ -9,6 +9,7 @@ packages=(
   libbullet-dev        # rigid rocks and the shovel (double-precision libraries)
   libeigen3-dev        # small dense linear algebra (principal axes of inertia)
   libccd-dev           # independent sphere-convex penetration, checked against our own in the tests
+  libfcl-dev           # the machine's path checked against the walls (FCL)
   libyaml-cpp-dev      # scenario files
   libopenmpi-dev openmpi-bin  # sweeps spread over MPI ranks
   python3-matplotlib   # run reports (figures)

@@ -22,6 +22,7 @@
 
 // rigid: Bullet's rocks, walls and the rope shovel
 #include "rigid/convex_polyhedron.h"
+#include "rigid/machine_path.h"
 #include "rigid/motion_curves.h"
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"

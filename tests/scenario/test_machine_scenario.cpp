@@ -6,13 +6,16 @@
 #include "rigid/convex_polyhedron.h"
 #include "rigid/motion_curves.h"
 #include "rigid/rope_shovel.h"
+#include "scenario/run_limits.h"
 #include "scenario/runner.h"
+#include "scenario/simulation.h"
 #include "scenario/scenario.h"
 #include "scenario/helpers.h"
 #include "scenario/sweep.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -400,4 +403,40 @@ TEST_CASE("a faster dig shortens each pass's dig and keeps the poses and the res
     const rigid::MotionSample mid_default = cycle.at(46.0 + 7.5), mid_fast = fast.at(pass + 7.5 / factor);
     CHECK(mid_fast.hoist_length_m == Approx(mid_default.hoist_length_m).epsilon(1e-12));
     CHECK(coupling::dig_speed_scaled(cycle, 1.0).samples().size() == cycle.samples().size());
+}
+
+TEST_CASE("a cycle that crosses the truck is refused by check and by the run, naming part, wall, time and depth, "
+          "a material-only wall gives warnings",
+          "[scenario][shovel][machine_path]")
+{
+    const std::string dir = std::string(DIPPER_SOURCE_DIR) + "/examples/scenarios";
+    const std::string shipped = test::read_text_file(dir + "/loading_three_passes.yaml");
+    const std::string placed = "translate_m: [-1.6, 19.25, 3.0]";
+    REQUIRE(shipped.find(placed) != std::string::npos);
+    // the shipped scenario passes, with a warning for each time the dipper reaches over the model's back end
+    const std::vector<std::string> warnings = check_scenario(parse_scenario(shipped, "three.yaml", dir));
+    REQUIRE(!warnings.empty());
+    CHECK_THAT(warnings[0], Catch::Contains("into wall 'back'") && Catch::Contains("material_only"));
+
+    // the truck's body raised 5 m: the dipper swings through its side on every pass
+    std::string raised = shipped;
+    raised.replace(raised.find(placed), placed.size(), "translate_m: [-1.6, 19.25, 8.0]");
+    const Scenario s = parse_scenario(raised, "raised.yaml", dir);
+    std::string e;
+    try {
+        check_scenario(s);
+    } catch (const InputError& error) {
+        e = error.what();
+    }
+    CHECK_THAT(e, Catch::Contains("raised.yaml: the shovel's cycle passes through walls that stand for steel"));
+    // the dig ends at 15 s and the swing to the truck follows (the times against the multibody: test_machine_path)
+    CHECK(std::regex_search(e, std::regex("dipper passes 0\\.[0-9]+ m into wall 'truck' from 2[0-9]\\.[0-9]+ s to [0-9.]+ s")));
+    CHECK_THAT(e, Catch::Contains("material_only: true"));
+    CHECK_THROWS_WITH(Simulation(s), Catch::Contains("passes through walls that stand for steel"));  // the run, before any particle
+
+    // marked as holding material only, the same crossings are warnings
+    std::string marked = raised;
+    marked.replace(marked.find("material: truck,"), 16, "material: truck, material_only: true,");
+    const std::vector<std::string> w = check_scenario(parse_scenario(marked, "marked.yaml", dir));
+    CHECK(std::any_of(w.begin(), w.end(), [](const std::string& x) { return x.find("into wall 'truck'") != std::string::npos; }));
 }
