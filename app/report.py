@@ -3,11 +3,80 @@ or DIR/sweep.md and sweep.png from what `dipper sweep` left there (sweep.csv).
 Usage: python3 report.py DIR"""
 import csv
 import json
+import math
 import os
+import re
+import subprocess
 import sys
 import textwrap
 
 folder = sys.argv[1]
+
+
+def wear_views(run_folder, vmax=None):
+    """Draws the 3-D wear views of a run folder with render.py in a child process (a VTK window that loses its
+    display aborts its process). Returns ([(title, file name)], why none were drawn or "")."""
+    render = os.path.join(os.path.dirname(os.path.abspath(__file__)), "render.py")
+    command = [sys.executable, render, "wear", run_folder] + (["--vmax", repr(vmax)] if vmax else [])
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=900)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return [], str(e)
+    if done.returncode != 0:
+        lines = [l for l in done.stderr.strip().splitlines() if l.strip()]
+        return [], lines[-1] if lines else f"render.py returned {done.returncode}"
+    return [tuple(p) for p in json.loads(done.stdout.strip().splitlines()[-1])], ""
+
+
+def make_film(run_folder):
+    """The run's frames as a film (render.py film, in a child process). Returns (what render.py wrote, why
+    there is no film or ""); runs with fewer than two frames get none and no reason."""
+    pvd = os.path.join(run_folder, "particles.pvd")
+    if not os.path.exists(pvd) or open(pvd).read().count("<DataSet") < 2:
+        return None, ""
+    render = os.path.join(os.path.dirname(os.path.abspath(__file__)), "render.py")
+    try:
+        done = subprocess.run([sys.executable, render, "film", run_folder], capture_output=True, text=True, timeout=3600)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return None, str(e)
+    if done.returncode != 0:
+        lines = [l for l in done.stderr.strip().splitlines() if l.strip()]
+        return None, lines[-1] if lines else f"render.py returned {done.returncode}"
+    film = json.loads(done.stdout.strip().splitlines()[-1])
+    film["key_frames"] = [tuple(k) for k in film["key_frames"]]
+    return film, ""
+
+
+def last_frame(run_folder, series):
+    """The VTK file of a .pvd series' last frame, read with VTK; None without the series or VTK."""
+    path = os.path.join(run_folder, series)
+    if not os.path.exists(path):
+        return None
+    try:
+        import vtk
+        import xml.etree.ElementTree as ET
+    except ImportError:
+        return None
+    frames = ET.parse(path).getroot().findall("./Collection/DataSet")
+    if not frames:
+        return None
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(os.path.join(run_folder, frames[-1].get("file")))
+    reader.Update()
+    return reader.GetOutput()
+
+
+def wear_maximum(run_folder):
+    """The top of a run folder's wear colour scale as render.py sets it (render.wear_maximum); 0 when there
+    is no wear surface or VTK is missing."""
+    try:
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import render
+    except ImportError:
+        return 0.0
+    finally:
+        sys.path.pop(0)
+    return render.wear_maximum(run_folder)
 
 
 def sweep_report(folder):
@@ -42,6 +111,7 @@ def sweep_report(folder):
     quantities = ([q for q in quantities if q[0] in columns] or
                   ([("repose_angle_deg", "angle of repose [deg]", 1.0)] if "repose_angle_deg" in columns else []) or
                   [("mass_kg", "mass [t]", 1e-3)])
+    quantities = [q for q in quantities if q[0] in columns]  # a table with none of them gets no figure
     # the parameter the figure is drawn against: the one that varies, seeds being repeats of each value
     varied = [p for p in parameters if len({r[p] for r in rows}) > 1]
     seeds = "seed" in varied and len(varied) > 1
@@ -64,7 +134,7 @@ def sweep_report(folder):
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     figures = 0
-    if groups:
+    if groups and quantities:
         try:
             import matplotlib
 
@@ -112,6 +182,20 @@ def sweep_report(folder):
             figures = 1
         except ImportError:
             lines += ["matplotlib is not installed (Debian: python3-matplotlib), so this report has no figure.", ""]
+    # the variants' wear views drawn again on one colour scale, so that they compare at a glance
+    runs = [(os.path.join(folder, f"variant_{int(r['variant']):03d}"), r) for r in rows if r.get("variant", "").isdigit()]
+    runs = [(d, r) for d, r in runs if os.path.isdir(d)]
+    top = max([wear_maximum(d) for d, _ in runs] + [0.0])
+    if top > 0.0:
+        lines += [f"## Wear views on one colour scale (0 to {top:.3g} mm/t)", ""]
+        for r, row in runs:
+            views, why = wear_views(r, top)
+            label = ", ".join(f"{p} = {row[p]}" for p in parameters)
+            if why:
+                lines += [f"variant {row['variant']} ({label}): no wear views ({why})", ""]
+                continue
+            lines += [f"variant {row['variant']} ({label}):", ""] + \
+                     [f"![{title}]({os.path.basename(r)}/{name})" for title, name in views] + [""]
     with open(os.path.join(folder, "sweep.md"), "w") as f:
         f.write("\n".join(lines))
     print(f"report: {os.path.join(folder, 'sweep.md')} with {figures} figure{'s' if figures != 1 else ''}")
@@ -189,11 +273,38 @@ try:
             figures.append(("Material in the dipper", "bucket.png"))
         passes = summary.get("passes", [])
         if passes:
-            fig, ax = plt.subplots(figsize=(6, 3.4), dpi=110)
-            ax.bar([p["pass"] for p in passes], [p["mass_kg"] / 1000.0 for p in passes], color="tab:brown")
+            # the thesis' loading of the same shovel and ore (Paper A, full-size model): 85, 80 and 68 t in
+            # passes 1 to 3; beside any run that loads (not the wear cycle, which empties over the pile)
+            thesis = [85.0, 80.0, 68.0]
+            loads = True
+            try:
+                import yaml
+
+                with open(os.path.join(folder, "scenario.yaml")) as f:
+                    given = yaml.safe_load(f) or {}
+                loads = (given.get("shovel") or {}).get("motion", "swing") != "dig_and_return"
+            except (ImportError, OSError):
+                pass  # without PyYAML or the scenario's copy: drawn beside the thesis' passes
+            number = [p["pass"] for p in passes]
+            fig, ax = plt.subplots(figsize=(6.4, 3.6), dpi=110)
+            width = 0.38 if loads else 0.7
+            ax.bar([k - (width / 2 if loads else 0) for k in number], [p["mass_kg"] / 1000.0 for p in passes],
+                   width=width, color="tab:brown", label="this run")
+            if loads:
+                shown = [k for k in number if k <= len(thesis)] or [1]
+                ax.bar([k + width / 2 for k in shown], [thesis[k - 1] for k in shown], width=width, color="0.65",
+                       label="thesis, full-size model (Paper A)")
+                for k in shown:
+                    ax.annotate(f"{thesis[k - 1]:.0f} t", (k + width / 2, thesis[k - 1]), ha="center", va="bottom", fontsize=8)
+                ax.legend(fontsize=8, loc="upper left", ncol=2)
+            for k, p in zip(number, passes):
+                ax.annotate(f"{p['mass_kg'] / 1000.0:.1f} t", (k - (width / 2 if loads else 0), p["mass_kg"] / 1000.0),
+                            ha="center", va="bottom", fontsize=8)
             ax.set_xlabel("pass")
             ax.set_ylabel("mass when the door opened [t]")
-            ax.set_xticks([p["pass"] for p in passes])
+            ax.set_xticks(number)
+            ax.set_xlim(min(number) - 0.6, max(number) + 0.6)
+            ax.set_ylim(0, 1.3 * max([p["mass_kg"] / 1000.0 for p in passes] + (thesis if loads else [])))
             ax.set_title("Mass per pass")
             ax.grid(True, axis="y", alpha=0.3)
             fig.tight_layout()
@@ -204,7 +315,26 @@ try:
     if fit:
         # the pile's surface as the repose probe read it at the end, and the line fitted to its slope
         along, surface, fitted = fit["bin_centre_m"], fit["surface_m"], fit["fitted"]
-        fig, ax = plt.subplots(figsize=(7, 3.6), dpi=110)
+        fig, ax = plt.subplots(figsize=(8, 4.4), dpi=110)
+        # the pile itself at the end, seen across the slope: each sphere as a circle of its radius, each rock's
+        # hull as its faces
+        axis = "xyz".index(fit["along"])
+        particles = last_frame(folder, "particles.pvd")
+        if particles is not None and particles.GetNumberOfPoints():
+            from matplotlib.collections import EllipseCollection, PolyCollection
+            from vtk.util.numpy_support import vtk_to_numpy
+
+            x = vtk_to_numpy(particles.GetPoints().GetData())
+            r = vtk_to_numpy(particles.GetPointData().GetArray("radius_m"))
+            ax.add_collection(EllipseCollection(2 * r, 2 * r, 0.0, units="xy", offsets=list(zip(x[:, axis], x[:, 2])),
+                                                transOffset=ax.transData, facecolors="0.78", edgecolors="0.55",
+                                                linewidths=0.2, label="spheres at the end"))
+            rocks = last_frame(folder, "rocks.pvd")
+            if rocks is not None and rocks.GetNumberOfPolys():
+                corners = vtk_to_numpy(rocks.GetPoints().GetData())
+                faces = vtk_to_numpy(rocks.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+                ax.add_collection(PolyCollection(corners[faces][:, :, [axis, 2]], facecolors="0.62", edgecolors="none"))
+            ax.autoscale_view()
         ax.plot([s for s, f in zip(along, fitted) if not f], [z for z, f in zip(surface, fitted) if not f], "o",
                 markersize=3, color="0.6", label="top of a bin, off the slope")
         ax.plot([s for s, f in zip(along, fitted) if f], [z for z, f in zip(surface, fitted) if f], "o",
@@ -212,16 +342,23 @@ try:
         ends = [min(s for s, f in zip(along, fitted) if f), max(s for s, f in zip(along, fitted) if f)]
         ax.plot(ends, [fit["intercept_m"] + fit["slope"] * s for s in ends], color="tab:blue", linewidth=1.5,
                 label=f"fitted line: {summary['repose_angle_deg']:.1f}°")
+        # the thesis' calibration pile (Paper A Fig. 12: 34.8°, from which its muck pile was cut), through the
+        # middle of the fitted line and falling the same way
+        middle = sum(ends) / 2.0
+        z_middle = fit["intercept_m"] + fit["slope"] * middle
+        thesis_slope = math.copysign(math.tan(math.radians(34.8)), fit["slope"])
+        ax.plot(ends, [z_middle + thesis_slope * (s - middle) for s in ends], "--", color="tab:red", linewidth=1.2,
+                label="the thesis' pile: 34.8°")
         ax.set_xlabel(f"{fit['along']} [m]")
         ax.set_ylabel("surface height [m]")
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
-        ax.set_title("Pile surface at the end and the angle of repose")
+        ax.set_title("The pile at the end, its surface and the angle of repose")
         fig.tight_layout()
         fig.savefig(os.path.join(folder, "repose.png"))
         plt.close(fig)
-        figures.append(("Pile surface at the end and the angle of repose", "repose.png"))
+        figures.append(("The pile at the end, its surface and the angle of repose", "repose.png"))
     note = ""
 except ImportError:
     note = "matplotlib is not installed (Debian: python3-matplotlib), so this report has no figures.\n"
@@ -330,13 +467,23 @@ for part, w in summary.get("wear", {}).items():
             fig.savefig(os.path.join(folder, f"wear_{part}_sections.png"))
             plt.close(fig)
             figures.append((f"Wear rate of {part} along its sections", f"wear_{part}_sections.png"))
-    if os.path.exists(os.path.join(folder, f"wear_{part}_map.png")):
-        figures.append((f"Wear rate of {part} (mm/t, seen from +z of the part)", f"wear_{part}_map.png"))
+views, why = wear_views(folder) if summary.get("wear") else ([], "")
+figures += views
+if why:
+    note += f"The 3-D wear views could not be drawn: {why}\n"
+film, why = make_film(folder)
+if film:
+    figures += film["key_frames"]
+if why:
+    note += f"The film of the run could not be made: {why}\n"
 lines.append("")
 if note:
     lines += [note]
 for title, name in figures:
     lines += [f"## {title}", "", f"![{title}]({name})", ""]
+if film:
+    lines += [f"The dig as a film: [`{film['film']}`]({film['film']}) ({film['frames']} frames, spheres and rocks "
+              "coloured by speed, the dig force with the time marked).", ""]
 lines += ["ParaView: open `particles.pvd` (glyph the points by `radius_m`), the `wall_*.pvd` series, and where present "
           "`rocks.pvd` and `wear_*.pvd` (fields depth_mm, rate_mm_per_t, mean_normal_force_N).", ""]
 with open(os.path.join(folder, "report.md"), "w") as f:

@@ -524,6 +524,14 @@ std::vector<std::string> CoSimulation::plate_names(const WearPart& w) const
     return names;
 }
 
+const std::vector<std::uint32_t>& CoSimulation::triangle_plates(const WearPart& w) const
+{
+    static const std::vector<std::uint32_t> none;
+    if (w.part == "door") return dipper_.door.triangle_plate;
+    if (w.part == "dipper") return dipper_.body.triangle_plate;
+    return none;
+}
+
 void CoSimulation::wear_pose(const WearPart& w, Mat3& rotation, Vec3& origin_m) const
 {
     if (w.body >= 0 && rigid_->is_dynamic(w.body)) {

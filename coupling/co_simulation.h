@@ -163,6 +163,9 @@ public:
     /// The names of the plates of the dipper or the door, indexed as meshes::MachinePart::triangle_plate: bottom,
     /// lip, side_minus_y, side_plus_y, top, tooth_1 .., bar_1 ..; door. Empty for other parts.
     std::vector<std::string> plate_names(const WearPart& w) const;
+    /// Which plate each triangle of the dipper's or the door's wear surface belongs to (indexes plate_names);
+    /// empty for other parts.
+    const std::vector<std::uint32_t>& triangle_plates(const WearPart& w) const;
     /// Pose of a wear surface's mesh frame in the world now.
     void wear_pose(const WearPart& w, Mat3& rotation, Vec3& origin_m) const;
 

@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "core/files.h"
 #include "meshes/vtk_surface.h"
+#include "meshes/vtk_xml.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -11,21 +12,6 @@
 namespace dipper::dem {
 
 namespace {
-
-void write_vec3_array(std::ostream& out, const char* name, const std::vector<Vec3>& values)
-{
-    out << "<DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const Vec3& v : values) out << v.x << ' ' << v.y << ' ' << v.z << '\n';
-    out << "</DataArray>\n";
-}
-
-template <typename T>
-void write_scalar_array(std::ostream& out, const char* type, const char* name, const std::vector<T>& values)
-{
-    out << "<DataArray type=\"" << type << "\" Name=\"" << name << "\" format=\"ascii\">\n";
-    for (const T& v : values) out << +v << '\n';
-    out << "</DataArray>\n";
-}
 
 std::string numbered(const std::string& stem, int index)
 {
@@ -40,23 +26,26 @@ void write_particles_vtp(const World& world, const std::string& path)
 {
     const ParticleStore& p = world.particles();
     const std::size_t n = p.size();
-    std::ofstream out = open_for_writing(path);
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-        << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
-        << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n<Points>\n";
-    write_vec3_array(out, "position_m", p.position_m);
-    out << "</Points>\n<PointData Scalars=\"radius_m\" Vectors=\"velocity_m_per_s\">\n";
-    write_scalar_array(out, "Float64", "radius_m", p.radius_m);
-    write_vec3_array(out, "velocity_m_per_s", p.velocity_m_per_s);
-    write_vec3_array(out, "angular_velocity_rad_per_s", p.angular_velocity_rad_per_s);
-    write_scalar_array(out, "UInt16", "material", p.material);
-    write_scalar_array(out, "UInt32", "id", p.id);
-    out << "</PointData>\n<Verts>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) out << i << '\n';
-    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) out << i + 1 << '\n';
-    out << "</DataArray>\n</Verts>\n</Piece>\n</PolyData>\n</VTKFile>\n";
-    finish_writing(out, path);
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
+    const auto vec3 = [](const std::vector<Vec3>& v) { return v.empty() ? nullptr : &v[0].x; };
+    meshes::VtkAppendedArrays arrays;
+    std::string body = concat("<PolyData>\n<Piece NumberOfPoints=\"", n, "\" NumberOfVerts=\"", n,
+                              "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n<Points>\n");
+    body += arrays.add("position_m", vec3(p.position_m), 3 * n, 3);
+    body += "</Points>\n<PointData Scalars=\"radius_m\" Vectors=\"velocity_m_per_s\">\n";
+    body += arrays.add("radius_m", p.radius_m.data(), n);
+    body += arrays.add("velocity_m_per_s", vec3(p.velocity_m_per_s), 3 * n, 3);
+    body += arrays.add("angular_velocity_rad_per_s", vec3(p.angular_velocity_rad_per_s), 3 * n, 3);
+    body += arrays.add("material", p.material.data(), n);
+    body += arrays.add("id", p.id.data(), n);
+    std::vector<std::int64_t> connectivity(n), offsets(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        connectivity[i] = static_cast<std::int64_t>(i);
+        offsets[i] = static_cast<std::int64_t>(i + 1);
+    }
+    body += "</PointData>\n<Verts>\n" + arrays.add("connectivity", connectivity.data(), n) + arrays.add("offsets", offsets.data(), n) +
+            "</Verts>\n</Piece>\n</PolyData>\n";
+    arrays.write(path, "PolyData", body);
 }
 
 void write_mesh_vtp(const MeshWall& wall, const std::string& path)

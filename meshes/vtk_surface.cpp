@@ -2,21 +2,9 @@
 
 #include "core/errors.h"
 #include "core/files.h"
+#include "meshes/vtk_xml.h"
 
 namespace dipper::meshes {
-
-namespace {
-
-void write_fields(std::ostream& out, const std::vector<ScalarField>& fields)
-{
-    for (const auto& [name, values] : fields) {
-        out << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-        for (const double v : values) out << v << '\n';
-        out << "</DataArray>\n";
-    }
-}
-
-}  // namespace
 
 void write_surface_vtp(const std::string& path, const std::vector<Vec3>& vertices_m,
                        const std::vector<std::array<std::uint32_t, 3>>& triangles,
@@ -27,29 +15,29 @@ void write_surface_vtp(const std::string& path, const std::vector<Vec3>& vertice
     for (const auto& f : cell_fields)
         DIPPER_ASSERT(f.second.size() == triangles.size(), "cell field '" + f.first + "' needs one value per triangle");
 
-    std::ofstream out = open_for_writing(path);
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-        << "<Piece NumberOfPoints=\"" << vertices_m.size()
-        << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" << triangles.size() << "\">\n";
-    out << "<Points>\n<DataArray type=\"Float64\" Name=\"position_m\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (const Vec3& v : vertices_m) out << v.x << ' ' << v.y << ' ' << v.z << '\n';
-    out << "</DataArray>\n</Points>\n";
-    if (!point_fields.empty()) {
-        out << "<PointData Scalars=\"" << point_fields.front().first << "\">\n";
-        write_fields(out, point_fields);
-        out << "</PointData>\n";
+    VtkAppendedArrays arrays;
+    std::string body = concat("<PolyData>\n<Piece NumberOfPoints=\"", vertices_m.size(),
+                              "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"", triangles.size(), "\">\n");
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
+    body += "<Points>\n" + arrays.add("position_m", vertices_m.empty() ? nullptr : &vertices_m[0].x, 3 * vertices_m.size(), 3) + "</Points>\n";
+    const auto fields = [&](const char* tag, const std::vector<ScalarField>& list) {
+        if (list.empty()) return;
+        body += concat("<", tag, " Scalars=\"", list.front().first, "\">\n");
+        for (const auto& [name, values] : list) body += arrays.add(name, values.data(), values.size());
+        body += concat("</", tag, ">\n");
+    };
+    fields("PointData", point_fields);
+    fields("CellData", cell_fields);
+    std::vector<std::int64_t> connectivity, offsets;
+    connectivity.reserve(3 * triangles.size());
+    offsets.reserve(triangles.size());
+    for (const auto& t : triangles) {
+        connectivity.insert(connectivity.end(), {t[0], t[1], t[2]});
+        offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
     }
-    if (!cell_fields.empty()) {
-        out << "<CellData Scalars=\"" << cell_fields.front().first << "\">\n";
-        write_fields(out, cell_fields);
-        out << "</CellData>\n";
-    }
-    out << "<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& t : triangles) out << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
-    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t k = 0; k < triangles.size(); ++k) out << 3 * (k + 1) << '\n';
-    out << "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
-    finish_writing(out, path);
+    body += "<Polys>\n" + arrays.add("connectivity", connectivity.data(), connectivity.size()) +
+            arrays.add("offsets", offsets.data(), offsets.size()) + "</Polys>\n</Piece>\n</PolyData>\n";
+    arrays.write(path, "PolyData", body);
 }
 
 }  // namespace dipper::meshes

@@ -395,7 +395,7 @@ PYBIND11_MODULE(_dipper, m)
                      const std::vector<std::string> plates = sim->plate_names(w);
                      if (!plates.empty()) {
                          d["plate_names"] = plates;
-                         d["triangle_plate"] = scalar_view(w.part == "dipper" ? sim->dipper().body.triangle_plate : sim->dipper().door.triangle_plate, self);
+                         d["triangle_plate"] = scalar_view(sim->triangle_plates(w), self);
                      }
                      l.append(d);
                  }

@@ -251,7 +251,7 @@ public:
         }
         if (options_.progress) progress(start, first_step, terminal, true);
         if (sim_) {
-            write_wear_maps();
+            write_final_wear();
             try {
                 compare_measured_wear();  // the points were checked against the surfaces before the run
             } catch (const InputError& e) {
@@ -436,23 +436,14 @@ private:
         return wall_seconds_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
     }
 
-    /// A PNG wear map (mm/t) of each wear surface seen from +z of its own frame (the dipper's bottom seen
-    /// from inside, a floor), once material has passed; a part with no face towards +z gets none.
-    void write_wear_maps()
+    /// Each wear surface at the end in its part's own frame (the dipper's: x from the heel to the lip, z up from
+    /// the bottom), with the plate of each triangle: what the report draws its 3-D wear views from.
+    void write_final_wear()
     {
         for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
             const coupling::WearPart& w = sim_->wear()[k];
-            const double tonnage = wear_tonnage_t(scenario_, *sim_, k);
-            if (!(tonnage > 0.0)) continue;
-            wear::MapView view;
-            // the dipper's bottom, seen from inside: its top plate's outside lies above it
-            if (w.part == "dipper") view.max_along_view_m = sim_->dipper().parameters.height_m / 2.0;
-            try {
-                wear::write_wear_map_png(*w.surface, dir_ + "/wear_" + w.part + "_map.png", tonnage, scenario_.wear[k].smoothing_iterations,
-                                         view);
-            } catch (const InputError&) {
-                // no triangle of the part faces +z: no map
-            }
+            wear::write_wear_vtp(*w.surface, dir_ + "/wear_" + w.part + "_final.vtp", wear_tonnage_t(scenario_, *sim_, k),
+                                 scenario_.wear[k].smoothing_iterations, Mat3::identity(), {}, sim_->triangle_plates(w));
         }
     }
 
@@ -694,6 +685,12 @@ private:
                 << ", \"law\": \"" << spec.law
                 << "\", \"constant\": " << json_number(spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
                 << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth);
+            const std::vector<std::string> plates = r.plate_names(w);
+            if (!plates.empty()) {
+                out << ", \"plates\": [";
+                for (std::size_t g = 0; g < plates.size(); ++g) out << (g ? ", " : "") << "\"" << json_escape(plates[g]) << "\"";
+                out << "]";
+            }
             const auto regions = r.wear_by_region(w);
             if (!regions.empty()) {
                 out << ", \"volume_by_region_m3\": {";

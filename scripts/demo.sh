@@ -9,5 +9,5 @@ out=out/loading_quick
 ./build/dipper run examples/scenarios/loading_quick.yaml --out "$out" "$@"
 echo
 sed -n '/^| pass |/,/^$/p' "$out/report.md"
-echo "report: $out/report.md (figures: dig force, material in the dipper, mass per pass, wear map)"
+echo "report: $out/report.md (figures: dig force, material in the dipper, mass per pass, the dipper's wear in 3-D)"
 echo "ParaView: $out/particles.pvd, $out/wall_dipper.pvd, $out/wear_dipper.pvd"

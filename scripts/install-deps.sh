@@ -6,17 +6,19 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libassimp-dev        # mesh files (STL, OBJ, PLY)
+  zlib1g-dev           # the VTK output's arrays compressed
   libbullet-dev        # rigid rocks and the shovel (double-precision libraries)
   libeigen3-dev        # small dense linear algebra (principal axes of inertia)
   libccd-dev           # independent sphere-convex penetration, checked against our own in the tests
   libfcl-dev           # the machine's path checked against the walls (FCL)
   libyaml-cpp-dev      # scenario files
   libopenmpi-dev openmpi-bin  # sweeps spread over MPI ranks
-  python3-matplotlib   # run reports (figures)
+  python3-matplotlib python3-pil  # run reports (figures; the film as an animated GIF)
   catch2               # unit and analytic tests (v2.13)
   libbenchmark-dev     # micro-benchmarks
   libomp-dev           # OpenMP runtime headers for clang users; g++ ships libgomp
-  python3 python3-vtk9 # tests read our VTK output with the real VTK reader
+  python3 python3-vtk9 # tests read our VTK output with the real VTK reader; the report draws with VTK
+  xvfb libgl1-mesa-dri # an X server in memory and Mesa's software OpenGL for VTK's renderer without a display
   python3-dev pybind11-dev python3-numpy  # the Python module dipper
   python3-pytest python3-yaml python3-pandas  # its tests; scenarios from dicts; tables as DataFrames
 )

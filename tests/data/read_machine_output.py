@@ -71,8 +71,32 @@ for wall in ("wall_dipper.pvd", "wall_door.pvd"):
     assert len(frames(wall)) == 4, wall
 assert not any(name.startswith("wall_rock") for name in os.listdir(folder)), "rock hulls are not written as walls"
 
+# the surface at the end in the dipper's own frame (heel at the origin, bottom at z = 0), with its plates
+final = read("wear_dipper_final.vtp")
+assert final.GetNumberOfPolys() == cells, (final.GetNumberOfPolys(), cells)
+lo = [min(final.GetPoint(i)[k] for i in range(final.GetNumberOfPoints())) for k in range(3)]
+hi = [max(final.GetPoint(i)[k] for i in range(final.GetNumberOfPoints())) for k in range(3)]
+assert -0.5 < lo[0] <= 1e-9 and -0.5 < lo[2] < 0.0 and abs(lo[1] + hi[1]) < 1e-6, (lo, hi)  # plates 0.1-0.2 m thick
+plate = final.GetCellData().GetArray("plate")
+plates = summary["wear"]["dipper"]["plates"]
+assert plates[:5] == ["bottom", "lip", "side_minus_y", "side_plus_y", "top"], plates
+assert {int(plate.GetValue(k)) for k in range(cells)} == set(range(len(plates)))
+volume = final.GetCellData().GetArray("wear_volume_m3")
+assert abs(sum(volume.GetValue(k) for k in range(cells)) - total) <= 1e-9 * total
+
 report = open(os.path.join(folder, "report.md")).read()
+for view in ("front", "below", "lip"):  # the 3-D wear views drawn from it (no tonnage yet: wear depth)
+    png = f"wear_dipper_{view}.png"
+    assert f"]({png})" in report and os.path.getsize(os.path.join(folder, png)) > 20000, png
 for png in ("dig_force.png", "bucket.png"):
     assert f"]({png})" in report and os.path.getsize(os.path.join(folder, png)) > 1000, png
+# the film: one picture per frame of the run's output
+from PIL import Image
+
+film = Image.open(os.path.join(folder, "dig.gif"))
+assert film.n_frames == len(frames("particles.pvd")) == 4, film.n_frames
+assert film.size == (960, 600), film.size
+assert "](dig.gif)" in report, "the report does not link the film"
+
 print(f"dipper run output with rocks and the shovel: {summary['rocks']} rocks in {len(rock_frames)} frames, "
       f"{touched} dipper triangles touched, {len(rows)} probe rows: ok")

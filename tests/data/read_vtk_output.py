@@ -44,4 +44,19 @@ with open(os.path.join(folder, "world.csv")) as f:
     rows = list(csv.DictReader(f))
 assert len(rows) == 3
 assert float(rows[-1]["time_s"]) == times[-1] or abs(float(rows[-1]["time_s"]) - times[-1]) < 1e-12
+# the compressed arrays: empty ones, and ones over several blocks read back bit for bit
+reader = vtk.vtkXMLPolyDataReader()
+reader.SetFileName(os.path.join(folder, "empty.vtp"))
+reader.Update()
+assert reader.GetOutput().GetNumberOfPoints() == 0
+reader = vtk.vtkXMLPolyDataReader()
+reader.SetFileName(os.path.join(folder, "large.vtp"))
+reader.Update()
+large = reader.GetOutput()
+expected = [tuple(float(v) for v in line.split()) for line in open(os.path.join(folder, "large_positions.txt"))]
+assert len(expected) >= 4000 and large.GetNumberOfPoints() == len(expected), (large.GetNumberOfPoints(), len(expected))
+assert 24 * len(expected) > 65536  # the positions span more than one compressed block
+assert all(large.GetPoint(i) == expected[i] for i in range(len(expected))), "positions differ from the text's"
+assert large.GetPointData().GetArray("id").GetValue(len(expected) - 1) == len(expected) - 1
+
 print("VTK read 3 particle frames of 32 points, the floor mesh and the CSV: ok")

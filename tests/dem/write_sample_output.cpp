@@ -4,6 +4,7 @@
 #include "dem/output.h"
 #include "meshes/triangle_mesh.h"
 
+#include <fstream>
 #include <iostream>
 
 int main(int argc, char** argv)
@@ -24,6 +25,16 @@ int main(int argc, char** argv)
         series.write(w);
         csv.write_row(w);
     }
+    // the compressed arrays' edge cases: a world without particles (empty arrays), and 4,000 particles whose
+    // arrays span several 64 KiB blocks, with their positions as text to compare bit for bit
+    World empty(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    write_particles_vtp(empty, std::string(argv[1]) + "/empty.vtp");
+    World large(MaterialTable::aitik_copper_ore(), WorldSettings{});
+    fill_lattice(large, {0, 0, 0}, {2.0, 2.0, 1.0}, 0.02, 0.05, large.materials().index_of("ore"), 0.003, 5);
+    write_particles_vtp(large, std::string(argv[1]) + "/large.vtp");
+    std::ofstream text(std::string(argv[1]) + "/large_positions.txt");
+    text.precision(17);
+    for (const Vec3& x : large.particles().position_m) text << x.x << ' ' << x.y << ' ' << x.z << '\n';
     std::cout << "wrote 3 frames of " << w.particles().size() << " particles to " << argv[1] << "\n";
     return 0;
 }
