@@ -309,25 +309,6 @@ double CoSimulation::tonnage_t() const
     return kg / 1000.0;
 }
 
-namespace {
-
-/// True if x lies inside the plate's steel: behind its face by at most its thickness, and inside the
-/// face's convex quadrilateral.
-bool inside_plate(const meshes::Plate& p, const Vec3& x)
-{
-    const Vec3 n = p.normal();
-    const double depth = dot(x - p.corners_m[0], n);
-    if (depth > 0.0 || depth < -p.thickness_m) return false;
-    for (std::size_t k = 0; k < 4; ++k) {
-        const Vec3& a = p.corners_m[k];
-        const Vec3& b = p.corners_m[(k + 1) % 4];
-        if (dot(cross(b - a, x - a), n) < 0.0) return false;
-    }
-    return true;
-}
-
-}  // namespace
-
 bool CoSimulation::clear_of_machine(const Vec3& c, double r) const
 {
     for (const int wall : {dipper_wall_, door_wall_}) {
@@ -365,7 +346,7 @@ void CoSimulation::check_tunnelling() const
             const Vec3 q = pt.back * (c - pt.origin);
             if (norm_squared(q - pt.bound.centre) > pt.bound.radius * pt.bound.radius) continue;  // far from every plate
             for (std::size_t p = 0; p < pt.plates->size(); ++p)
-                if (inside_plate((*pt.plates)[p], q)) return (part << 16) + p;
+                if ((*pt.plates)[p].contains(q)) return (part << 16) + p;
         }
         return kNone;
     };

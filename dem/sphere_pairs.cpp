@@ -4,10 +4,56 @@
 #include "dem/pair_batch.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <numeric>
 #include <omp.h>
 
 namespace dipper::dem {
+
+CellGrid CellGrid::sorting(const std::vector<Vec3>& positions, double min_cell_m, std::vector<std::uint32_t>& order)
+{
+    const std::size_t n = positions.size();
+    Vec3 lo{0.0, 0.0, 0.0}, hi{0.0, 0.0, 0.0};
+    if (n > 0) {
+        lo = hi = positions[0];
+        for (const Vec3& p : positions) {
+            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+    }
+    CellGrid grid;
+    grid.lo = lo;
+    double& cell = grid.cell;
+    cell = std::max(min_cell_m, 1e-12);
+    int* dims = grid.dims;
+    const std::size_t max_cells = std::max<std::size_t>(64, 4 * n);
+    for (;;) {
+        // counted in doubles: a particle thrown far away must not overflow the cell count
+        double total = 1.0;
+        for (int a = 0; a < 3; ++a) total *= std::floor((hi[a] - lo[a]) / cell) + 1.0;
+        if (total <= static_cast<double>(max_cells)) break;
+        cell *= std::max(1.25, std::cbrt(total / static_cast<double>(max_cells)));  // sparse: coarser cells
+    }
+    for (int a = 0; a < 3; ++a) dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
+    const std::size_t cell_count = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
+
+    // sort particles by cell (counting sort, stable) for memory locality
+    std::vector<std::uint32_t>& cell_start = grid.cell_start;
+    cell_start.assign(cell_count + 1, 0);
+    std::vector<std::uint32_t> particle_cell(n);
+    order.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        particle_cell[i] = grid.cell_of(positions[i]);
+        ++cell_start[particle_cell[i] + 1];
+    }
+    std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
+    {
+        std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+        for (std::size_t i = 0; i < n; ++i) order[fill[particle_cell[i]]++] = static_cast<std::uint32_t>(i);
+    }
+    return grid;
+}
 
 void SpherePairs::rebuild(const ParticleStore& p, const CellGrid& grid, double skin_m, const std::vector<std::uint32_t>& old_to_new, int threads)
 {

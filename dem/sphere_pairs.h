@@ -28,6 +28,11 @@ struct CellGrid {
     int dims[3] = {1, 1, 1};
     std::vector<std::uint32_t> cell_start;  ///< the particles of cell c are [cell_start[c], cell_start[c + 1])
 
+    /// The grid over the positions' bounding box, cells at least min_cell_m wide (coarser where the particles
+    /// are sparse: at most max(64, 4 n) cells), and in `order` the particles sorted by cell (a stable counting
+    /// sort: order[k] is the k-th particle in cell order) with cell_start counted for that order.
+    static CellGrid sorting(const std::vector<Vec3>& positions, double min_cell_m, std::vector<std::uint32_t>& order);
+
     std::uint32_t cell_of(const Vec3& p) const
     {
         int c[3];

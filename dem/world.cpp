@@ -404,35 +404,6 @@ void World::finish_step(double dt_s)
     if (max_overlap_ratio_ > settings_.max_overlap_ratio) fail_overlap();
 }
 
-const std::vector<ContactRecord>& World::last_contact_records() const
-{
-    if (!records_stale_) return records_;
-    // the contacts of planes and open meshes in particle order, then those of convex bodies, in particle order
-    std::vector<const WallContact*> contacts(wall_contacts_.size());
-    for (std::size_t k = 0; k < wall_contacts_.size(); ++k) contacts[k] = &wall_contacts_[k];
-    for (std::size_t k = 0; k < convex_.size(); ++k)
-        if (convex_.touching(k)) contacts.push_back(&convex_.contact(k));
-    records_.resize(contacts.size());
-#pragma omp parallel for schedule(static) num_threads(threads_)
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-        const WallContact& c = *contacts[k];
-        ContactRecord& r = records_[k];
-        r.point_world = c.point;
-        r.normal_world = c.normal;
-        r.normal_force_N = c.forces.normal_force_N;
-        r.tangential_force_N = c.forces.tangential_force_N;
-        r.relative_displacement_m = c.relative_displacement_m;
-        r.overlap_m = c.overlap_m;
-        r.surface_id = c.wall;
-        r.triangle_id = c.triangle;
-        r.particle_index = static_cast<std::int32_t>(c.particle);
-        r.particle_mass_kg = particles_.mass_kg[c.particle];
-        r.first_step = c.first_step;
-    }
-    records_stale_ = false;
-    return records_;
-}
-
 std::string World::where_in_time() const
 {
     return concat("step ", step_count_, " (t=", time_s_, " s)");
@@ -449,44 +420,9 @@ void World::rebuild()
     for (double r : particles_.radius_m) r_max = std::max(r_max, r);
     skin_m_ = settings_.skin_fraction_of_radius * r_max;
 
-    // the cell grid over the particles' bounding box; cells at least one interaction range wide
-    Vec3 lo{0.0, 0.0, 0.0}, hi{0.0, 0.0, 0.0};
-    if (n > 0) {
-        lo = hi = particles_.position_m[0];
-        for (const Vec3& p : particles_.position_m) {
-            lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-            hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-        }
-    }
-    CellGrid grid;
-    grid.lo = lo;
-    double& cell = grid.cell;
-    cell = std::max(2.0 * r_max + skin_m_, 1e-12);
-    int* dims = grid.dims;
-    const std::size_t max_cells = std::max<std::size_t>(64, 4 * n);
-    for (;;) {
-        // counted in doubles: a particle thrown far away must not overflow the cell count
-        double total = 1.0;
-        for (int a = 0; a < 3; ++a) total *= std::floor((hi[a] - lo[a]) / cell) + 1.0;
-        if (total <= static_cast<double>(max_cells)) break;
-        cell *= std::max(1.25, std::cbrt(total / static_cast<double>(max_cells)));  // sparse: coarser cells
-    }
-    for (int a = 0; a < 3; ++a) dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
-    const std::size_t cell_count = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
-
-    // sort particles by cell (counting sort, stable) for memory locality
-    std::vector<std::uint32_t>& cell_start = grid.cell_start;
-    cell_start.assign(cell_count + 1, 0);
-    std::vector<std::uint32_t> particle_cell(n), order(n), old_to_new(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        particle_cell[i] = grid.cell_of(particles_.position_m[i]);
-        ++cell_start[particle_cell[i] + 1];
-    }
-    std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
-    {
-        std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
-        for (std::size_t i = 0; i < n; ++i) order[fill[particle_cell[i]]++] = static_cast<std::uint32_t>(i);
-    }
+    // the cell grid over the particles, and their order sorted by cell
+    std::vector<std::uint32_t> order, old_to_new(n);
+    const CellGrid grid = CellGrid::sorting(particles_.position_m, 2.0 * r_max + skin_m_, order);
     for (std::size_t k = 0; k < n; ++k) old_to_new[order[k]] = static_cast<std::uint32_t>(k);
     particles_.permute(order);
     stiffness_radius_N_per_m_.resize(n);
@@ -506,7 +442,9 @@ void World::rebuild()
 
     // planes and triangles near each particle, and the pairs of spheres and convex bodies, which take the
     // history of their contacts
-    build_wall_candidates(grid);
+    candidates_.build(grid, particles_, skin_m_, {planes_, plane_offset_m_, plane_wall_id_, meshes_, mesh_wall_id_, wall_removed_},
+                      convex_, threads_);
+    convex_contact_count_ = 0;
     split_convex_contacts();
 
     reference_position_m_ = particles_.position_m;
@@ -520,176 +458,10 @@ void World::rebuild()
     }
 }
 
-void World::build_wall_candidates(const CellGrid& grid)
-{
-    const Vec3& lo = grid.lo;
-    const double cell = grid.cell;
-    const int* dims = grid.dims;
-    const std::vector<std::uint32_t>& cell_start = grid.cell_start;
-    const std::size_t n = particles_.size();
-    candidate_start_.assign(n + 1, 0);
-    candidates_.clear();
-    candidate_triangles_.clear();
-    candidate_ids_.clear();
-    if (walls_.empty() || n == 0) {
-        split_candidates();
-        return;
-    }
-    double r_max = 0.0;
-    for (double r : particles_.radius_m) r_max = std::max(r_max, r);
-    const double reach = r_max + skin_m_;
-
-    // Triangles into every cell their inflated bounding box overlaps; a convex body (a rock) as a whole, by its
-    // bounding sphere, into every cell that sphere's inflated box overlaps, for its particles to test all its
-    // faces (a triangle within reach of a centre is within reach of the sphere, so the candidates are the same,
-    // in the same order). The thesis' pile then puts its 20,188 rocks into the cells on one thread instead of
-    // their 645,464 triangles, and needs none of their vertices in the world frame.
-    constexpr std::uint32_t kWholeMesh = kPlaneCandidate - 1;
-    const std::size_t cell_count = cell_start.size() - 1;
-    // the large lists live in scratch_ from rebuild to rebuild: fresh ones of some megabytes would be mapped
-    // and faulted in page by page each time (measured: a third of the rebuild)
-    std::vector<std::uint32_t> bucket_count(cell_count + 1, 0);
-    auto& entries = scratch_.entries;
-    entries.clear();
-    // the cells of the box [vmin - reach, vmax + reach] that hold a particle
-    auto bin = [&](const Vec3& vmin, const Vec3& vmax, MeshCandidate what) {
-        int c0[3], c1[3];
-        for (int a = 0; a < 3; ++a) {
-            const double f0 = std::floor((vmin[a] - reach - lo[a]) / cell), f1 = std::floor((vmax[a] + reach - lo[a]) / cell);
-            if (f1 < 0.0 || f0 > dims[a] - 1) return;
-            c0[a] = static_cast<int>(std::max(f0, 0.0));
-            c1[a] = static_cast<int>(std::min(f1, static_cast<double>(dims[a] - 1)));
-        }
-        for (int z = c0[2]; z <= c1[2]; ++z)
-            for (int y = c0[1]; y <= c1[1]; ++y)
-                for (int x = c0[0]; x <= c1[0]; ++x) {
-                    const auto c = static_cast<std::uint32_t>((static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x);
-                    if (cell_start[c] == cell_start[c + 1]) continue;  // no particle there
-                    entries.push_back({c, what});
-                }
-    };
-    for (std::size_t m = 0; m < meshes_.size(); ++m) {
-        const MeshWall& mw = meshes_[m];
-        if (wall_removed_[static_cast<std::size_t>(mesh_wall_id_[m])]) continue;
-        if (mw.convex()) {
-            const Vec3 centre = mw.bound_centre_world_m();
-            const double radius = mw.bound_radius_m();
-            bin(centre - Vec3{radius, radius, radius}, centre + Vec3{radius, radius, radius},
-                {static_cast<std::uint32_t>(m), kWholeMesh});
-            continue;
-        }
-        const auto& verts = mw.vertices_world_m();
-        const auto& tris = mw.mesh().triangles();
-        for (std::size_t t = 0; t < tris.size(); ++t) {
-            const Vec3& a = verts[tris[t][0]];
-            const Vec3& b = verts[tris[t][1]];
-            const Vec3& c = verts[tris[t][2]];
-            bin({std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})},
-                {std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})},
-                {static_cast<std::uint32_t>(m), static_cast<std::uint32_t>(t)});
-        }
-    }
-    for (const auto& e : entries) ++bucket_count[e.first + 1];
-    std::partial_sum(bucket_count.begin(), bucket_count.end(), bucket_count.begin());
-    auto& bucket = scratch_.bucket;
-    bucket.resize(entries.size());
-    {
-        std::vector<std::uint32_t> fill(bucket_count.begin(), bucket_count.end() - 1);
-        for (const auto& e : entries) bucket[fill[e.first]++] = e.second;
-    }
-
-    // Each particle keeps the planes, then the triangles of its own cell, that lie within r + skin. The particles
-    // go in blocks handed out as threads come free, joined in block order: the cells of a bed's bottom or of a
-    // pile's rocks hold most of the candidates, so equal halves of the particles are far from equal work (in the
-    // thesis' settling column the first of two threads took nearly twice as long as the second).
-    auto& per_block = scratch_.per_block;
-    const int blocks = threads_ == 1 ? 1 : 16 * threads_;
-    per_block.resize(static_cast<std::size_t>(blocks));
-    std::vector<std::uint32_t> counts(n, 0);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
-    for (int b = 0; b < blocks; ++b) {
-        std::size_t begin, end;
-        thread_block(n, b, blocks, begin, end);
-        std::vector<MeshCandidate> out = std::move(per_block[static_cast<std::size_t>(b)]);  // a local, moved back at
-        out.clear();                                                                         // the end (the headers share a cache line)
-        for (std::size_t i = begin; i < end; ++i) {
-            const Vec3 p = particles_.position_m[i];
-            int c[3];
-            for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - lo[a]) / cell), 0, dims[a] - 1);
-            const auto cid = static_cast<std::size_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
-            const double range = particles_.radius_m[i] + skin_m_;
-            for (std::size_t q = 0; q < planes_.size(); ++q)
-                if (dot(p, planes_[q].normal) - plane_offset_m_[q] < range && !wall_removed_[static_cast<std::size_t>(plane_wall_id_[q])]) {
-                    out.push_back({static_cast<std::uint32_t>(q), kPlaneCandidate});
-                    ++counts[i];
-                }
-            std::uint32_t body_mesh = kPlaneCandidate;
-            Vec3 pb;
-            double behind = range;
-            for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1]; ++k) {
-                const MeshCandidate mc = bucket[k];
-                if (mc.mesh != body_mesh) {
-                    body_mesh = mc.mesh;
-                    pb = meshes_[mc.mesh].to_body(p);
-                    // A convex body's face that the centre lies more than the skin behind cannot come to face
-                    // it before the next rebuild, and only faces it faces can hold its contact (find_wall_contacts)
-                    behind = meshes_[mc.mesh].convex() ? skin_m_ : range;
-                }
-                const MeshWall& mw = meshes_[mc.mesh];
-                if (mc.triangle == kWholeMesh) {
-                    // no face of a body whose bounding sphere lies beyond reach (with a margin far above round-off)
-                    const double beyond = (mw.bound_radius_m() + range) * (1.0 + 1e-9);
-                    if (norm_squared(pb - mw.bound_centre_body_m()) > beyond * beyond) continue;
-                }
-                const std::uint32_t first = mc.triangle == kWholeMesh ? 0 : mc.triangle;
-                const std::uint32_t last = mc.triangle == kWholeMesh ? static_cast<std::uint32_t>(mw.mesh().triangle_count()) : mc.triangle + 1;
-                for (std::uint32_t tri = first; tri < last; ++tri) {
-                    const PackedTriangle& pt = mw.packed_body(tri);
-                    const double plane_distance = dot(pb - pt.a, pt.normal);
-                    if (plane_distance >= range || plane_distance <= -behind) continue;
-                    if (meshes::closest_point_on_triangle(pb, pt.a, pt.b, pt.c).distance_squared < range * range) {
-                        out.push_back({mc.mesh, tri});
-                        ++counts[i];
-                    }
-                }
-            }
-        }
-        per_block[static_cast<std::size_t>(b)] = std::move(out);
-    }
-    for (std::size_t i = 0; i < n; ++i) candidate_start_[i + 1] = candidate_start_[i] + counts[i];
-    for (const auto& v : per_block) candidates_.insert(candidates_.end(), v.begin(), v.end());
-    split_candidates();
-}
-
-
 void World::split_candidates()
 {
-    // Planes and open meshes stay with their particle; the triangles of a convex body become one pair of the sphere
-    // and that body (ConvexPairs)
-    const std::size_t n = candidate_start_.empty() ? 0 : candidate_start_.size() - 1;
-    convex_.build(candidate_start_, candidates_, meshes_, threads_);
+    candidates_.split(meshes_, convex_, threads_);
     convex_contact_count_ = 0;
-
-    // the other candidates, with their triangles beside them
-    wall_candidate_start_.assign(n + 1, 0);
-    wall_candidates_.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-        for (std::uint32_t k = candidate_start_[i]; k < candidate_start_[i + 1]; ++k) {
-            const MeshCandidate mc = candidates_[k];
-            if (mc.triangle == kPlaneCandidate || !meshes_[mc.mesh].convex()) wall_candidates_.push_back(mc);
-        }
-        wall_candidate_start_[i + 1] = static_cast<std::uint32_t>(wall_candidates_.size());
-    }
-    wall_particles_.clear();
-    for (std::size_t i = 0; i < n; ++i)
-        if (wall_candidate_start_[i + 1] > wall_candidate_start_[i]) wall_particles_.push_back(static_cast<std::uint32_t>(i));
-    candidate_triangles_.resize(wall_candidates_.size());
-    candidate_ids_.resize(wall_candidates_.size());
-    for (std::size_t k = 0; k < wall_candidates_.size(); ++k)
-        if (wall_candidates_[k].triangle != kPlaneCandidate) {
-            candidate_triangles_[k] = meshes_[wall_candidates_[k].mesh].packed_body(wall_candidates_[k].triangle);
-            candidate_ids_[k] = meshes_[wall_candidates_[k].mesh].triangle_ids(wall_candidates_[k].triangle);
-        }
 }
 
 void World::split_convex_contacts()
@@ -725,84 +497,8 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
 {
     const Vec3 x = particles_.position_m[i];
     const double r = particles_.radius_m[i];
-    hits.clear();
-    auto push_hit = [&](const WallHit& h) { hits.push_back(h); };
-
-    const std::uint32_t first = wall_candidate_start_[i], last = wall_candidate_start_[i + 1];
-    if (first == last) return;  // most particles: no plane or open mesh within reach since the last rebuild
-
-    // analytic planes (listed first)
-    std::uint32_t k = first;
-    for (; k < last && wall_candidates_[k].triangle == kPlaneCandidate; ++k) {
-        const std::size_t q = wall_candidates_[k].mesh;
-        const PlaneWall& pl = planes_[q];
-        const double dist = dot(x, pl.normal) - plane_offset_m_[q];
-        if (dist < r) push_hit({plane_wall_id_[q], -1, meshes::Feature::Face, 0, kPlaneCandidate, x - pl.normal * dist, pl.normal, r - dist, true});
-    }
-
-    // mesh triangles, each classified by the feature (face, edge, vertex) that holds the closest point; each
-    // mesh's triangles are tested in its body frame, with the sphere's centre moved there once per mesh
-    const int first_mesh_hit = static_cast<int>(hits.size());
-    std::uint32_t body_mesh = kPlaneCandidate;
-    const MeshWall* mw = nullptr;
-    Vec3 xb;
-    for (; k < last; ++k) {
-        const MeshCandidate mc = wall_candidates_[k];
-        if (mc.mesh != body_mesh) {
-            body_mesh = mc.mesh;
-            mw = &meshes_[mc.mesh];
-            xb = mw->to_body(x);
-        }
-        const PackedTriangle& pt = candidate_triangles_[k];
-        // a triangle whose plane is r or more away cannot be touched: one dot product spares the closest point
-        const double plane_distance = dot(xb - pt.a, pt.normal);
-        if (plane_distance >= r || plane_distance <= -r) continue;
-        const meshes::ClosestPoint cp = meshes::closest_point_on_triangle(xb, pt.a, pt.b, pt.c);
-        if (cp.distance_squared >= r * r) continue;
-        const double dist = std::sqrt(cp.distance_squared);
-        const Vec3 normal = mw->rotation() * (dist > 1e-12 * r ? (xb - cp.point) * (1.0 / dist) : pt.normal);
-        push_hit({mesh_wall_id_[mc.mesh], static_cast<std::int32_t>(mc.triangle), cp.feature, cp.local_index, k,
-                  mw->to_world(cp.point), normal, r - dist, true});
-    }
-
-    // One contact per point of the surface that is locally closest to the centre:
-    // - hits at the same point (closer than 1e-9 r) are one contact, however the triangles there classify it: a
-    //   feature shared by several triangles, or a centre whose projection lies within round-off of an edge or
-    //   vertex (a turned mesh, a sphere placed over a node), which can fall inside one triangle and on the border
-    //   of the next. The first hit there stays (its own decision is final, taken over all the hits);
-    // - a face hit counts;
-    // - an edge or vertex hit counts only if every triangle that shares that edge or vertex has its closest
-    //   point there too. A triangle's closest point is unique, so one elsewhere on a triangle that holds this
-    //   point is strictly closer, and this point is not a local minimum (however small the difference in
-    //   overlap: a centre 1 um beside an edge of a flat plate). Every triangle that holds the point lies within
-    //   r, so it is among the hits, and the check over the hits is exact.
-    // A lone mesh hit has nothing to be compared with (the common case: one face of a rock). The ids of the
-    // touched features are looked up only here.
-    const int hit_count = static_cast<int>(hits.size());
-    auto feature_id = [&](const WallHit& h) {
-        const TriangleIds& ids = candidate_ids_[h.candidate];
-        const auto local = static_cast<std::size_t>(h.local_index);
-        return h.feature == meshes::Feature::Edge ? ids.edges[local] : ids.vertices[local];
-    };
-    const double same_point2 = 1e-18 * r * r;
-    for (int a = first_mesh_hit; a < hit_count && hit_count - first_mesh_hit > 1; ++a) {
-        WallHit& h = hits[static_cast<std::size_t>(a)];
-        for (int b = first_mesh_hit; b < a && h.keep; ++b) {
-            const WallHit& o = hits[static_cast<std::size_t>(b)];
-            if (o.keep && o.wall == h.wall && norm_squared(o.point - h.point) < same_point2) h.keep = false;
-        }
-        if (!h.keep || h.feature == meshes::Feature::Face) continue;
-        const std::uint32_t id = feature_id(h);
-        for (int b = first_mesh_hit; b < hit_count && h.keep; ++b) {
-            const WallHit& o = hits[static_cast<std::size_t>(b)];
-            if (b == a || o.wall != h.wall || norm_squared(o.point - h.point) < same_point2) continue;
-            const TriangleIds& other = candidate_ids_[o.candidate];
-            const bool shares = h.feature == meshes::Feature::Edge
-                                    ? (other.edges[0] == id || other.edges[1] == id || other.edges[2] == id)
-                                    : (other.vertices[0] == id || other.vertices[1] == id || other.vertices[2] == id);
-            if (shares) h.keep = false;
-        }
-    }
+    candidates_.touching(i, x, r, {planes_, plane_offset_m_, plane_wall_id_, meshes_, mesh_wall_id_, wall_removed_}, hits);
+    if (hits.empty()) return;
 
     // forces, with history matched to last step's contact of the same wall whose normal is closest
     const std::uint32_t old_begin = i < wall_contact_start_.size() - 1 ? wall_contact_start_[i] : 0;
@@ -864,12 +560,12 @@ void World::wall_thread_block(int t, std::size_t& begin, std::size_t& end) const
     // without one (the candidates sit at the bottom and the sides of a bed, so equal particle counts
     // would give one thread most of the work). Bounds from the candidates' prefix sum by bisection.
     const std::size_t n = particles_.size();
-    if (wall_candidate_start_.size() != n + 1) {
+    if (!candidates_.lists_for(n)) {
         thread_block(n, t, threads_, begin, end);
         return;
     }
     constexpr std::size_t kCandidateWeight = 16;
-    auto weight = [&](std::size_t i) { return i + kCandidateWeight * wall_candidate_start_[i]; };
+    auto weight = [&](std::size_t i) { return i + kCandidateWeight * candidates_.first(i); };
     const std::size_t total = weight(n);
     auto bound = [&](int q) {
         const std::size_t target = total * static_cast<std::size_t>(q) / static_cast<std::size_t>(threads_);
@@ -937,8 +633,8 @@ void World::compute_wall_contacts(double dt_s)
         std::vector<WallHit> hits = std::move(thread_wall_hits_[static_cast<std::size_t>(t)]);
         out.clear();
         if (any_wall) {  // only the thread's particles with a plane or an open mesh within reach can touch one
-            const auto first = std::lower_bound(wall_particles_.begin(), wall_particles_.end(), begin);
-            const auto last = std::lower_bound(first, wall_particles_.end(), end);
+            const auto first = std::lower_bound(candidates_.particles().begin(), candidates_.particles().end(), begin);
+            const auto last = std::lower_bound(first, candidates_.particles().end(), end);
             for (auto i = first; i != last; ++i) find_wall_contacts(*i, dt_s, hits, out);
         }
         // the spheres near convex bodies, in particle order: each pair's contact in its place

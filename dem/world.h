@@ -8,6 +8,7 @@
 #include "dem/material.h"
 #include "dem/particle_store.h"
 #include "dem/sphere_pairs.h"
+#include "dem/wall_candidates.h"
 #include "dem/wall_contact.h"
 #include "dem/walls.h"
 
@@ -170,16 +171,6 @@ public:
 
 private:
     struct WallRef { bool is_mesh; int index; };
-    /// A touched wall feature before the one-contact-per-feature filter.
-    struct WallHit {
-        std::int32_t wall, triangle;
-        meshes::Feature feature;
-        std::int32_t local_index;  ///< which edge or vertex of the triangle (meshes::ClosestPoint)
-        std::uint32_t candidate;   ///< the triangle's place in candidates_ (kPlaneCandidate for a plane)
-        Vec3 point, normal;
-        double overlap;
-        bool keep;
-    };
 
     void sum_wall_reactions();
     void wall_thread_block(int t, std::size_t& begin, std::size_t& end) const;
@@ -189,9 +180,7 @@ private:
     void move_prescribed_meshes(double t_end_s, double dt_s);
     bool needs_rebuild(double particle_move_m) const;
     void rebuild();
-    void build_wall_candidates(const CellGrid& grid);
-    /// Splits candidates_ into the per-particle lists of planes and open meshes, with their triangles beside
-    /// them, and the pairs of spheres and convex bodies, in particle order.
+    /// The pairs of spheres and convex bodies and the per-particle lists of the other walls, from candidates_.
     void split_candidates();
     /// Moves the history of wall_contacts_ on convex bodies into their pairs; the rest stay, indexed by particle.
     void split_convex_contacts();
@@ -245,24 +234,11 @@ private:
     std::vector<WallContact> wall_contacts_;
     std::vector<std::uint32_t> wall_contact_start_;
     std::vector<std::size_t> wall_contact_offset_;  ///< per-thread offsets into wall_contacts_, this step
-    std::vector<std::uint32_t> candidate_start_;
-    std::vector<MeshCandidate> candidates_;            ///< every wall within reach of each particle, as found
-    // the planes and the triangles of open meshes, per particle (candidates_ less the convex bodies)
-    std::vector<std::uint32_t> wall_candidate_start_;
-    std::vector<MeshCandidate> wall_candidates_;
-    std::vector<std::uint32_t> wall_particles_;       ///< the particles with a wall candidate, in order
-    std::vector<PackedTriangle> candidate_triangles_;  ///< body frame, beside wall_candidates_ (planes: unused)
-    std::vector<TriangleIds> candidate_ids_;           ///< beside wall_candidates_, read only for touched triangles
+    WallCandidates candidates_;  ///< the walls within reach of each particle, found at each rebuild
     ConvexPairs convex_;  ///< the spheres within reach of convex bodies, with their contacts
     std::size_t convex_contact_count_ = 0;
     std::vector<std::size_t> thread_first_deep_convex_;  ///< per thread: first convex pair past the overlap limit
     std::vector<double> thread_convex_seconds_;           ///< per thread: its pass over its convex pairs, this step
-    /// The wall-candidate search's large working lists, kept for their capacity.
-    struct CandidateScratch {
-        std::vector<std::pair<std::uint32_t, MeshCandidate>> entries;  ///< (cell, triangle)
-        std::vector<MeshCandidate> bucket;                             ///< triangles by cell
-        std::vector<std::vector<MeshCandidate>> per_block;
-    } scratch_;
     std::vector<std::vector<WallContact>> thread_wall_contacts_;
     std::vector<std::vector<WallHit>> thread_wall_hits_;
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;

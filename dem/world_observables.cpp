@@ -14,6 +14,35 @@ std::size_t World::pair_contact_count() const { return pairs_.contact_count(); }
 
 std::vector<PairContactView> World::pair_contacts() const { return pairs_.contacts(particles_); }
 
+const std::vector<ContactRecord>& World::last_contact_records() const
+{
+    if (!records_stale_) return records_;
+    // the contacts of planes and open meshes in particle order, then those of convex bodies, in particle order
+    std::vector<const WallContact*> contacts(wall_contacts_.size());
+    for (std::size_t k = 0; k < wall_contacts_.size(); ++k) contacts[k] = &wall_contacts_[k];
+    for (std::size_t k = 0; k < convex_.size(); ++k)
+        if (convex_.touching(k)) contacts.push_back(&convex_.contact(k));
+    records_.resize(contacts.size());
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        const WallContact& c = *contacts[k];
+        ContactRecord& r = records_[k];
+        r.point_world = c.point;
+        r.normal_world = c.normal;
+        r.normal_force_N = c.forces.normal_force_N;
+        r.tangential_force_N = c.forces.tangential_force_N;
+        r.relative_displacement_m = c.relative_displacement_m;
+        r.overlap_m = c.overlap_m;
+        r.surface_id = c.wall;
+        r.triangle_id = c.triangle;
+        r.particle_index = static_cast<std::int32_t>(c.particle);
+        r.particle_mass_kg = particles_.mass_kg[c.particle];
+        r.first_step = c.first_step;
+    }
+    records_stale_ = false;
+    return records_;
+}
+
 double World::kinetic_energy_J() const
 {
     double e = 0.0;

@@ -56,8 +56,7 @@ void World::write_state(StateWriter& out) const
     }
     out.array(contacts);
     out.array(contact_start);
-    out.array(candidate_start_);
-    out.array(candidates_);
+    candidates_.write(out);
     out.array(wall_force_N_);
     out.array(wall_torque_N_m_);
     out.value(max_overlap_ratio_);
@@ -130,8 +129,7 @@ void World::read_state(StateReader& in)
     in.tag("wall-contacts");
     in.array(wall_contacts_);
     in.array(wall_contact_start_);
-    in.array(candidate_start_);
-    in.array(candidates_);
+    candidates_.read(in, planes_.size(), meshes_);
     in.array(wall_force_N_);
     in.array(wall_torque_N_m_);
     max_overlap_ratio_ = in.value<double>();
@@ -147,16 +145,11 @@ void World::read_state(StateReader& in)
         in.fail("reference arrays do not match the particle count");
     for (const WallContact& c : wall_contacts_)
         if (c.particle >= n || c.wall < 0 || static_cast<std::size_t>(c.wall) >= walls_.size()) in.fail("a wall contact out of range");
-    if (prepared_ && (!sized(wall_contact_start_.size(), n + 1) || !sized(candidate_start_.size(), n + 1)))
+    if (prepared_ && (!sized(wall_contact_start_.size(), n + 1) || !candidates_.sized_for(n, rebuild_needed_)))
         in.fail("contact index arrays do not match the particle count");
     if (!wall_contact_start_.empty() && wall_contact_start_.back() != wall_contacts_.size()) in.fail("wall contact index mismatch");
-    if (!candidate_start_.empty() && candidate_start_.back() != candidates_.size()) in.fail("wall candidate index mismatch");
-    if (!std::is_sorted(candidate_start_.begin(), candidate_start_.end()) || !std::is_sorted(wall_contact_start_.begin(), wall_contact_start_.end()))
+    if (!std::is_sorted(wall_contact_start_.begin(), wall_contact_start_.end()))
         in.fail("a wall contact or candidate index that does not ascend");
-    for (const MeshCandidate& c : candidates_) {
-        if (c.triangle == kPlaneCandidate ? c.mesh >= planes_.size() : (c.mesh >= meshes_.size() || c.triangle >= meshes_[c.mesh].mesh().triangle_count()))
-            in.fail("a wall candidate out of range");
-    }
     if (reference_mesh_version_.size() != reference_mesh_rotation_.size() ||
         reference_mesh_translation_m_.size() != reference_mesh_rotation_.size())
         in.fail("mesh reference arrays differ in length");

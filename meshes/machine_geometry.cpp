@@ -38,6 +38,19 @@ Vec3 Plate::normal() const
     return normalized(cross(corners_m[1] - corners_m[0], corners_m[3] - corners_m[0]));
 }
 
+bool Plate::contains(const Vec3& x) const
+{
+    const Vec3 n = normal();
+    const double depth = dot(x - corners_m[0], n);
+    if (depth > 0.0 || depth < -thickness_m) return false;
+    for (std::size_t k = 0; k < 4; ++k) {
+        const Vec3& a = corners_m[k];
+        const Vec3& b = corners_m[(k + 1) % 4];
+        if (dot(cross(b - a, x - a), n) < 0.0) return false;
+    }
+    return true;
+}
+
 std::vector<Vec3> Plate::solid_corners_m() const
 {
     const Vec3 back = normal() * (-thickness_m);

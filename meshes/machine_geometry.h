@@ -21,6 +21,9 @@ struct Plate {
     Vec3 normal() const;
     /// The eight corners of the solid.
     std::vector<Vec3> solid_corners_m() const;
+    /// True if x lies inside the plate's steel: behind its face by at most its thickness, and inside the
+    /// face's convex quadrilateral.
+    bool contains(const Vec3& x) const;
 };
 
 /// A plate whose face is the top (z = hi.z) of the box [lo, hi], normal +z.

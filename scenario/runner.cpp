@@ -6,7 +6,9 @@
 #include "dem/output.h"
 #include "coupling/mixed_bed.h"
 #include "scenario/keys.h"
+#include "scenario/detail/json.h"
 #include "scenario/simulation.h"
+#include "scenario/wear_results.h"
 #include "wear/calibration.h"
 #include "wear/wear_output.h"
 
@@ -25,6 +27,8 @@
 namespace dipper::scenario {
 
 namespace fs = std::filesystem;
+using detail::json_escape;
+using detail::json_number;
 
 namespace {
 
@@ -62,31 +66,6 @@ std::string numbered(const std::string& stem, int index)
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "_%06d.vtp", index);
     return stem + buffer;
-}
-
-std::string json_escape(const std::string& s)
-{
-    std::string out;
-    for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\', out += c;
-        else if (c == '\n') out += "\\n";
-        else if (static_cast<unsigned char>(c) < 32) {
-            char u[8];
-            std::snprintf(u, sizeof u, "\\u%04x", static_cast<unsigned>(c));
-            out += u;
-        }
-        else out += c;
-    }
-    return out;
-}
-
-/// A number for JSON: full precision, or null where a diverged run left it non-finite.
-std::string json_number(double v)
-{
-    if (!std::isfinite(v)) return "null";
-    char buffer[40];
-    std::snprintf(buffer, sizeof buffer, "%.10g", v);
-    return buffer;
 }
 
 std::string clock_text(double seconds)
@@ -250,23 +229,11 @@ public:
             result.message = in_scenario_keys(e.what());
         }
         if (options_.progress) progress(start, first_step, terminal, true);
-        if (sim_) {
-            write_final_wear();
-            try {
-                compare_measured_wear();  // the points were checked against the surfaces before the run
-            } catch (const InputError& e) {
-                // a run stopped before it wore the measured points keeps its summary (resume it to the end); a
-                // finished one that did not wear them is the user's error, reported after the summary is written
-                if (result.status == RunStatus::completed) calibration_error_ = e.what();
-                else result.message = concat(result.message, "; no wear calibration yet: ", e.what());
-                calibrations_.resize(sim_->wear().size());
-            }
-            write_wear_sections();
-        }
+        if (sim_) wear_results_.finish(scenario_, *sim_, dir_, result.status == RunStatus::completed, result.message);
         result.time_s = world_->time_s();
         result.steps = world_->step_count();
         write_summary(result, start);
-        if (!calibration_error_.empty()) throw InputError(calibration_error_);
+        if (!wear_results_.error().empty()) throw InputError(wear_results_.error());
         return result;
     }
 
@@ -434,61 +401,6 @@ private:
     double wall_seconds_now() const
     {
         return wall_seconds_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
-    }
-
-    /// Each wear surface at the end in its part's own frame (the dipper's: x from the heel to the lip, z up from
-    /// the bottom), with the plate of each triangle: what the report draws its 3-D wear views from.
-    void write_final_wear()
-    {
-        for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
-            const coupling::WearPart& w = sim_->wear()[k];
-            wear::write_wear_vtp(*w.surface, dir_ + "/wear_" + w.part + "_final.vtp", wear_tonnage_t(scenario_, *sim_, k),
-                                 scenario_.wear[k].smoothing_iterations, Mat3::identity(), {}, sim_->triangle_plates(w));
-        }
-    }
-
-    /// With a measurement file: the measured against the simulated rates at the points, and the wear
-    /// constant that makes their means agree (wear/calibration.h); written to wear_<part>_points.csv.
-    void compare_measured_wear()
-    {
-        calibrations_.clear();
-        for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
-            const WearSpec& spec = scenario_.wear[k];
-            const double tonnage = wear_tonnage_t(scenario_, *sim_, k);
-            if (spec.measured_file.empty() || !(tonnage > 0.0)) {
-                calibrations_.emplace_back();
-                continue;
-            }
-            const auto points = wear::read_measured_points(spec.measured_file);
-            const wear::CalibrationResult c = wear::calibrate(*sim_->wear()[k].surface, tonnage, spec.smoothing_iterations, points,
-                                                              wear::MeasurementUncertainty{}, kMeasuredPointTolerance_m);
-            wear::write_points_csv(dir_ + "/wear_" + spec.part + "_points.csv", c.before);
-            calibrations_.push_back(c);
-        }
-    }
-
-    /// Each section's simulated rate profile with the measured points near it, in
-    /// wear_<part>_section_<name>.csv (the run's constant; the calibrated one scales it by `scale`).
-    void write_wear_sections()
-    {
-        sections_.clear();
-        for (std::size_t k = 0; k < sim_->wear().size(); ++k) {
-            const WearSpec& spec = scenario_.wear[k];
-            const double tonnage = wear_tonnage_t(scenario_, *sim_, k);
-            sections_.emplace_back();
-            if (spec.sections.empty() || !(tonnage > 0.0)) continue;
-            const wear::RateMap map(*sim_->wear()[k].surface, tonnage, spec.smoothing_iterations);
-            const std::vector<wear::PointComparison> none;
-            const auto& measured = k < calibrations_.size() && calibrations_[k].scale > 0.0 ? calibrations_[k].before : none;
-            for (const WearSectionSpec& section : spec.sections) {
-                SectionResult r;
-                r.name = section.name;
-                r.profile = wear::sample_section(map, section.points_m, section.spacing_m, kMeasuredPointTolerance_m, section.name);
-                r.measured = wear::points_on_section(section.points_m, measured, kMeasuredPointTolerance_m);
-                wear::write_section_csv(dir_ + "/wear_" + spec.part + "_section_" + section.name + ".csv", r.profile, r.measured);
-                sections_.back().push_back(std::move(r));
-            }
-        }
     }
 
     void checkpoint()
@@ -675,65 +587,8 @@ private:
             }
             out << (r.passes().empty() ? "]" : "\n  ]");
         }
-        out << ",\n  \"tonnage_t\": " << json_number(r.tonnage_t()) << ",\n  \"wear\": {";
-        for (std::size_t k = 0; k < r.wear().size(); ++k) {
-            const coupling::WearPart& w = r.wear()[k];
-            const WearSpec& spec = scenario_.wear[k];
-            const std::vector<double> depth = w.surface->node_depth_m(spec.smoothing_iterations);
-            const double max_depth = depth.empty() ? 0.0 : *std::max_element(depth.begin(), depth.end());
-            out << (k ? ", " : "") << "\"" << json_escape(spec.part) << "\": {\"tonnage_t\": " << json_number(wear_tonnage_t(scenario_, r, k))
-                << ", \"law\": \"" << spec.law
-                << "\", \"constant\": " << json_number(spec.constant) << ", \"volume_m3\": " << json_number(w.surface->total_volume_m3())
-                << ", \"max_depth_mm\": " << json_number(1000.0 * max_depth);
-            const std::vector<std::string> plates = r.plate_names(w);
-            if (!plates.empty()) {
-                out << ", \"plates\": [";
-                for (std::size_t g = 0; g < plates.size(); ++g) out << (g ? ", " : "") << "\"" << json_escape(plates[g]) << "\"";
-                out << "]";
-            }
-            const auto regions = r.wear_by_region(w);
-            if (!regions.empty()) {
-                out << ", \"volume_by_region_m3\": {";
-                for (std::size_t g = 0; g < regions.size(); ++g)
-                    out << (g ? ", " : "") << "\"" << regions[g].first << "\": " << json_number(regions[g].second);
-                out << "}";
-            }
-            if (k < calibrations_.size() && calibrations_[k].scale > 0.0) {
-                const wear::CalibrationResult& c = calibrations_[k];
-                out << ", \"measured\": {\"points\": " << c.before.size() << ", \"mean_measured_mm_per_t\": "
-                    << json_number(c.summary_before.mean_measured) << ", \"mean_simulated_mm_per_t\": "
-                    << json_number(c.summary_before.mean_simulated) << ", \"correlation\": " << json_number(c.summary_before.correlation)
-                    << ", \"scale\": " << json_number(c.scale) << ", \"calibrated_constant\": " << json_number(c.calibrated_constant)
-                    << ", \"calibrated_constant_low\": " << json_number(c.constant_low)
-                    << ", \"calibrated_constant_high\": " << json_number(c.constant_high) << "}";
-            }
-            if (k < sections_.size() && !sections_[k].empty()) {
-                out << ", \"sections\": {";
-                for (std::size_t q = 0; q < sections_[k].size(); ++q) {
-                    const SectionResult& sr = sections_[k][q];
-                    double sum = 0.0, peak = 0.0, measured_sum = 0.0, simulated_at_points = 0.0;
-                    for (const wear::SectionSample& x : sr.profile) {
-                        sum += x.simulated_rate;
-                        peak = std::max(peak, x.simulated_rate);
-                    }
-                    for (const wear::SectionPoint& m : sr.measured) {
-                        measured_sum += m.comparison.measured_rate;
-                        simulated_at_points += m.comparison.simulated_rate;
-                    }
-                    const double n = static_cast<double>(sr.measured.size());
-                    out << (q ? ", " : "") << "\"" << json_escape(sr.name) << "\": {\"samples\": " << sr.profile.size()
-                        << ", \"mean_simulated_mm_per_t\": " << json_number(sum / static_cast<double>(sr.profile.size()))
-                        << ", \"max_simulated_mm_per_t\": " << json_number(peak) << ", \"measured_points\": " << sr.measured.size();
-                    if (n > 0)
-                        out << ", \"mean_measured_mm_per_t\": " << json_number(measured_sum / n)
-                            << ", \"mean_simulated_at_points_mm_per_t\": " << json_number(simulated_at_points / n);
-                    out << "}";
-                }
-                out << "}";
-            }
-            out << "}";
-        }
-        out << "}";
+        out << ",\n  \"tonnage_t\": " << json_number(r.tonnage_t()) << ",\n  \"wear\": ";
+        wear_results_.write_json(out, scenario_, r);
     }
 
     Scenario scenario_;
@@ -742,14 +597,7 @@ private:
     std::unique_ptr<Simulation> model_;
     dem::World* world_ = nullptr;             ///< model_'s DEM world
     coupling::CoSimulation* sim_ = nullptr;   ///< model_'s co-simulation: rocks, shovel and wear; null for spheres and walls only
-    std::vector<wear::CalibrationResult> calibrations_;  ///< per wear surface, at the end (scale 0: none)
-    std::string calibration_error_;  ///< why a finished run's wear could not be calibrated (after the summary)
-    struct SectionResult {
-        std::string name;
-        std::vector<wear::SectionSample> profile;
-        std::vector<wear::SectionPoint> measured;
-    };
-    std::vector<std::vector<SectionResult>> sections_;  ///< per wear surface, at the end
+    WearResults wear_results_;  ///< the wear surfaces' outputs at the end
     std::vector<int> walls_;             ///< the walls outputs list
     std::unique_ptr<dem::PvdCollection> particles_pvd_;
     std::vector<std::unique_ptr<dem::PvdCollection>> wall_pvd_;
