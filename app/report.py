@@ -328,7 +328,7 @@ try:
             r = vtk_to_numpy(particles.GetPointData().GetArray("radius_m"))
             ax.add_collection(EllipseCollection(2 * r, 2 * r, 0.0, units="xy", offsets=list(zip(x[:, axis], x[:, 2])),
                                                 transOffset=ax.transData, facecolors="0.78", edgecolors="0.55",
-                                                linewidths=0.2, label="spheres at the end"))
+                                                linewidths=0.2))
             rocks = last_frame(folder, "rocks.pvd")
             if rocks is not None and rocks.GetNumberOfPolys():
                 corners = vtk_to_numpy(rocks.GetPoints().GetData())

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "core/files.h"
+#include "scenario/run_limits.h"
 #include "scenario/sweep.h"
 
 #include <yaml-cpp/yaml.h>
@@ -102,6 +103,9 @@ ReposeCalibration calibrate_repose(const std::string& file, const std::string& a
 {
     const Scenario base = load_scenario(file);
     if (!base.repose) throw InputError(concat(file, ": no probes.repose; the calibration fits the angle that probe measures"));
+    // side walls that hold the pile by friction bias the angle the calibration fits: said before the runs
+    const std::vector<std::string> wall_warnings = repose_wall_warnings(base, build_world(base)->materials());
+    for (const std::string& w : wall_warnings) std::fprintf(stderr, "dipper: warning: %s\n", w.c_str());
     // the pair's entry in materials.pairs, which the trials change
     const std::string text = read_text(file);
     const YAML::Node pairs = YAML::Load(text)["materials"]["pairs"];
@@ -149,7 +153,8 @@ ReposeCalibration calibrate_repose(const std::string& file, const std::string& a
                          static_cast<unsigned long long>(base.seed + static_cast<std::uint64_t>(seed_index)), angle);
         return angle;
     };
-    const ReposeCalibration c = search_repose(angle_of, search);
+    ReposeCalibration c = search_repose(angle_of, search);
+    for (auto w = wall_warnings.rbegin(); w != wall_warnings.rend(); ++w) c.notes.insert(c.notes.begin(), "warning: " + *w);
 
     const std::string csv_path = (fs::path(out_dir) / "calibration.csv").string();
     std::ofstream csv = open_for_writing(csv_path);

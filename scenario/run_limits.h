@@ -29,10 +29,16 @@ void require_spheres_at_start(const Scenario& scenario, const dem::World& world)
 /// stands for steel, and returns one warning for each crossing of a wall marked `material_only`. Nothing
 /// without a shovel.
 std::vector<std::string> require_clear_path(const Scenario& scenario, const coupling::CoSimulation& sim);
+/// A repose probe's slope between side walls that hold the particles by friction reads high: one warning per
+/// such plane (a vertical plane facing across the slope whose pair with a fill's or pour's material has sliding
+/// or rolling friction), with the coefficients. Measured: about 3 deg per wall in a 0.9 m slice of 150 mm spheres,
+/// none from frictionless walls at any width (docs/results.md). Nothing without a repose probe.
+std::vector<std::string> repose_wall_warnings(const Scenario& scenario, const dem::MaterialTable& materials);
 /// What `dipper check` does past parsing: builds the world with its mesh files and Bullet's side, checks the
 /// material pairs, places the pours due at t = 0 where the time step depends on them, and checks the
 /// intervals against the step and the memory against the machine's, and the shovel's path against the walls;
-/// an InputError for what the run would refuse at its start. Returns the warnings (require_clear_path).
+/// an InputError for what the run would refuse at its start. Returns the warnings (require_clear_path,
+/// repose_wall_warnings).
 std::vector<std::string> check_scenario(const Scenario& scenario);
 
 }  // namespace dipper::scenario

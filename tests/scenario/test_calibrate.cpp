@@ -3,12 +3,14 @@
 #include "core/errors.h"
 #include "scenario/calibrate.h"
 #include "scenario/helpers.h"
+#include "scenario/run_limits.h"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 using namespace dipper;
@@ -114,4 +116,32 @@ TEST_CASE("dipper's repose calibration runs the scenario and writes its table", 
     CHECK_THROWS_WITH(calibrate_repose(std::string(DIPPER_SOURCE_DIR) + "/tests/data/scenarios/repose_small.yaml", "ore", "rock", s, dir, o),
                       Catch::Contains("materials.pairs has no entry for ore-rock"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("a repose slice between side walls with friction is warned of but not one between frictionless walls",
+          "[scenario][calibrate]")
+{
+    // repose.yaml: the slope runs along x between side walls side_a (y = 0) and side_b (y = 0.9). Measured
+    // (docs/results.md): each side wall of Table 2's ore-ground pair raises the angle by about 3 deg; frictionless
+    // ones change nothing at any width, and the back wall (normal along x) is not a side wall.
+    const std::string dir = DIPPER_SOURCE_DIR "/examples/scenarios";
+    const std::string shipped = test::read_text_file(dir + "/repose.yaml");
+    // as shipped: frictionless side walls, and a back wall of bucket (ore friction 0.53) facing along the slope
+    CHECK_THAT(shipped, Catch::Contains("normal: [1, 0, 0],  material: bucket"));
+    CHECK(check_scenario(parse_scenario(shipped, "repose.yaml", dir)).empty());
+
+    const std::string one = std::regex_replace(shipped, std::regex("(name: side_a, [^}]*material: )steel"), "$1ground");
+    REQUIRE(one != shipped);
+    const std::vector<std::string> w = check_scenario(parse_scenario(one, "one.yaml", dir));
+    REQUIRE(w.size() == 1);
+    CHECK_THAT(w[0], Catch::Contains("plane 'side_a' (ground)") && Catch::Contains("friction 0.9") &&
+                         Catch::Contains("rolling friction 0.3"));
+
+    // read along y, the walls facing y lie along the slope and the back wall (bucket) faces across it
+    const std::string along_y = std::regex_replace(one, std::regex("along: x"), "along: y");
+    REQUIRE(along_y != one);
+    const Scenario y = parse_scenario(along_y, "y.yaml", dir);
+    const std::vector<std::string> wy = repose_wall_warnings(y, build_world(y)->materials());
+    REQUIRE(wy.size() == 1);
+    CHECK_THAT(wy[0], Catch::Contains("plane 'back' (bucket)") && Catch::Contains("friction 0.53"));
 }
