@@ -207,7 +207,7 @@ def film(folder, every=1):
     step_s = (times[-1] - times[0]) / max(1, len(times) - 1)
     # played at about 4 times real speed, at most 10 frames a second
     duration_ms = max(100, int(round(1000.0 * step_s / 4.0)))
-    palette = [p.convert("P", palette=Image.ADAPTIVE, colors=128) for p in pictures]
+    palette = [p.convert("P", palette=Image.ADAPTIVE, colors=256) for p in pictures]
     palette[0].save(os.path.join(folder, gif), save_all=True, append_images=palette[1:], duration=duration_ms, loop=0,
                     optimize=True)
     keys = []
