@@ -442,7 +442,7 @@ void World::rebuild()
 
     // planes and triangles near each particle, and the pairs of spheres and convex bodies, which take the
     // history of their contacts
-    candidates_.build(grid, particles_, skin_m_, {planes_, plane_offset_m_, plane_wall_id_, meshes_, mesh_wall_id_, wall_removed_},
+    candidates_.build(grid, particles_, skin_m_, wall_set(),
                       convex_, threads_);
     convex_contact_count_ = 0;
     split_convex_contacts();
@@ -497,7 +497,7 @@ void World::find_wall_contacts(std::uint32_t i, double dt_s, std::vector<WallHit
 {
     const Vec3 x = particles_.position_m[i];
     const double r = particles_.radius_m[i];
-    candidates_.touching(i, x, r, {planes_, plane_offset_m_, plane_wall_id_, meshes_, mesh_wall_id_, wall_removed_}, hits);
+    candidates_.touching(i, x, r, wall_set(), hits);
     if (hits.empty()) return;
 
     // forces, with history matched to last step's contact of the same wall whose normal is closest

@@ -182,6 +182,8 @@ private:
     void rebuild();
     /// The pairs of spheres and convex bodies and the per-particle lists of the other walls, from candidates_.
     void split_candidates();
+    /// The walls as the wall-candidate search and the contact geometry read them.
+    WallSet wall_set() const { return {planes_, plane_offset_m_, plane_wall_id_, meshes_, mesh_wall_id_, wall_removed_}; }
     /// Moves the history of wall_contacts_ on convex bodies into their pairs; the rest stay, indexed by particle.
     void split_convex_contacts();
     /// wall_contacts_ with the touching pairs' contacts added, sorted by particle (rebuilds and checkpoints).
