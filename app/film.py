@@ -58,7 +58,7 @@ def film(folder, every=1):
         if poly.GetNumberOfPoints():
             boxes.append(np.array(poly.GetBounds()))
         for name, by_time in walls.items():
-            if moving[name] or name in ("truck",):
+            if moving[name]:
                 boxes.append(np.array(read(by_time.get(t) or list(by_time.values())[-1]).GetBounds()))
     lo = np.min([b[0::2] for b in boxes], axis=0)
     hi = np.max([b[1::2] for b in boxes], axis=0)
@@ -129,7 +129,7 @@ def film(folder, every=1):
         actor = vtk.vtkActor()
         actor.SetMapper(mapper)
         actor.GetProperty().SetColor(*((0.45, 0.47, 0.5) if moving[name] else (0.7, 0.72, 0.75)))
-        actor.GetProperty().SetOpacity(1.0 if moving[name] or name == "truck" else 0.18)
+        actor.GetProperty().SetOpacity(1.0 if moving[name] else 0.18)
         actor.GetProperty().SetSpecular(0.3 if moving[name] else 0.0)
         renderer.AddActor(actor)
         wall_actors[name] = (actor, mapper)

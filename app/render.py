@@ -549,7 +549,18 @@ def main(argv):
 
         print(json.dumps(film(argv[2])))
         return 0
-    vmax = float(argv[argv.index("--vmax") + 1]) if "--vmax" in argv else None
+    vmax = None
+    if "--vmax" in argv:
+        k = argv.index("--vmax") + 1
+        try:
+            vmax = float(argv[k])
+        except (IndexError, ValueError):
+            print(f"render.py: --vmax needs a number of mm/t above 0; got {argv[k] if k < len(argv) else 'nothing'}",
+                  file=sys.stderr)
+            return 2
+        if not vmax > 0.0:
+            print(f"render.py: --vmax needs a number of mm/t above 0; got {argv[k]}", file=sys.stderr)
+            return 2
     pictures = wear_pictures(argv[2], vmax)
     print(json.dumps(pictures))
     return 0
