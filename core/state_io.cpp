@@ -84,6 +84,12 @@ std::string StateReader::text()
     return s;
 }
 
+void StateReader::count(std::size_t n, const char* what)
+{
+    const auto read = value<std::uint64_t>();
+    if (read != n) fail(concat("the state has ", read, " ", what, ", the world built from its input ", n));
+}
+
 void StateReader::tag(const char* name)
 {
     const std::string got = text();

@@ -258,49 +258,22 @@ void CoSimulation::add_rock_wear()
             for (const ContactRecord& r : rigid_->surface_contacts(w.body, w.wall, &w.surface->mesh())) w.surface->add_contact(r, dt);
 }
 
-void CoSimulation::write_state(StateWriter& out) const
+template <class IO, class Self>
+void CoSimulation::state_fields(IO& io, Self& s)
 {
-    rigid_->write_state(out);
-    coupled_->write_state(out);
-    out.tag("scene");
-    out.value<std::uint64_t>(wear_.size());
-    for (const WearPart& w : wear_) w.surface->write_state(out);
-    out.array(passes_);
-    out.value<std::uint8_t>(door_open_ ? 1 : 0);
-    out.value(pass_start_s_);
-    out.value(dig_start_s_);
-    out.value(dig_end_s_);
-    out.value(dig_force_sum_);
-    out.value(dig_force_peak_);
-    out.value(interface_force_sum_);
-    out.value(interface_force_peak_);
-    out.value(without_lip_sum_);
-    out.value(without_lip_peak_);
-    out.value(dig_samples_);
-    domain_.write_state(out);
+    io.object(*s.rigid_);
+    io.object(*s.coupled_);
+    io.tag("scene");
+    io.count(s.wear_.size(), "wear surfaces");
+    for (auto& w : s.wear_) io.object(*w.surface);
+    io(s.passes_, s.door_open_, s.pass_start_s_, s.dig_start_s_, s.dig_end_s_, s.dig_force_sum_, s.dig_force_peak_,
+       s.interface_force_sum_, s.interface_force_peak_, s.without_lip_sum_, s.without_lip_peak_, s.dig_samples_);
+    io.object(s.domain_);
 }
 
-void CoSimulation::read_state(StateReader& in)
-{
-    rigid_->read_state(in);
-    coupled_->read_state(in);
-    in.tag("scene");
-    if (in.value<std::uint64_t>() != wear_.size()) in.fail("another number of wear surfaces than the scenario has");
-    for (WearPart& w : wear_) w.surface->read_state(in);
-    in.array(passes_);
-    door_open_ = in.value<std::uint8_t>() != 0;
-    pass_start_s_ = in.value<double>();
-    dig_start_s_ = in.value<double>();
-    dig_end_s_ = in.value<double>();
-    dig_force_sum_ = in.value<double>();
-    dig_force_peak_ = in.value<double>();
-    interface_force_sum_ = in.value<double>();
-    interface_force_peak_ = in.value<double>();
-    without_lip_sum_ = in.value<double>();
-    without_lip_peak_ = in.value<double>();
-    dig_samples_ = in.value<std::uint64_t>();
-    domain_.read_state(in);
-}
+void CoSimulation::write_state(StateWriter& out) const { state_fields(out, *this); }
+
+void CoSimulation::read_state(StateReader& in) { state_fields(in, *this); }
 
 double CoSimulation::tonnage_t() const
 {

@@ -185,6 +185,9 @@ public:
     void read_state(StateReader& in);
 
 private:
+    /// The checkpoint's fields, listed once for writing and reading (core/state_io.h).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     void place_moving_walls(double t_s);
     void add_rock_wear();
     void track_passes();

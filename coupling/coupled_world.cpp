@@ -120,16 +120,33 @@ rigid::BodyId CoupledWorld::add_rock(const rigid::ConvexPolyhedron& shape, doubl
     return id;
 }
 
+namespace {
+
+/// What a checkpoint holds of each rock, listed once for writing and reading (core/state_io.h): its hull and
+/// its materials; its pose is the rigid world's.
+struct RockFields {
+    std::vector<Vec3> vertices;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    double density = 0.0;
+    std::int32_t rigid_material = 0;
+    dem::MaterialIndex dem_material = 0;
+
+    template <class IO>
+    void fields(IO& io)
+    {
+        io(vertices, triangles, density, rigid_material, dem_material);
+    }
+};
+
+}  // namespace
+
 void CoupledWorld::write_rocks(StateWriter& out) const
 {
     out.tag("rocks");
     out.value<std::uint64_t>(rocks_.size());
     for (const RockRecord& r : rocks_) {
-        out.array(r.shape.vertices_m());
-        out.array(r.shape.triangles());
-        out.value(r.density_kg_per_m3);
-        out.value<std::int32_t>(r.rigid_material);
-        out.value(r.dem_material);
+        RockFields f{r.shape.vertices_m(), r.shape.triangles(), r.density_kg_per_m3, r.rigid_material, r.dem_material};
+        f.fields(out);
     }
 }
 
@@ -147,19 +164,14 @@ void CoupledWorld::read_rocks(StateReader& in)
     std::vector<Read> read;
     double reach_m = 0.0;  // of the largest rock, from its centroid
     for (std::uint64_t k = 0; k < n; ++k) {
-        std::vector<Vec3> vertices;
-        std::vector<std::array<std::uint32_t, 3>> triangles;
-        in.array(vertices);
-        in.array(triangles);
-        const double density = in.value<double>();
-        const int rigid_material = in.value<std::int32_t>();
-        const auto dem_material = in.value<dem::MaterialIndex>();
-        for (const auto& t : triangles)
+        RockFields f;
+        f.fields(in);
+        for (const auto& t : f.triangles)
             for (std::uint32_t v : t)
-                if (v >= vertices.size()) in.fail(concat("rock ", k, " has a triangle with vertex ", v, " of ", vertices.size()));
+                if (v >= f.vertices.size()) in.fail(concat("rock ", k, " has a triangle with vertex ", v, " of ", f.vertices.size()));
         try {
-            read.push_back({rigid::ConvexPolyhedron::from_mesh(meshes::TriangleMesh(std::move(vertices), std::move(triangles), "checkpoint rock")),
-                            density, rigid_material, dem_material});
+            read.push_back({rigid::ConvexPolyhedron::from_mesh(meshes::TriangleMesh(std::move(f.vertices), std::move(f.triangles), "checkpoint rock")),
+                            f.density, f.rigid_material, f.dem_material});
         } catch (const InputError& e) {
             in.fail(concat("rock ", k, ": ", e.what()));
         }
@@ -179,54 +191,23 @@ void CoupledWorld::read_rocks(StateReader& in)
     }
 }
 
-void CoupledWorld::write_state(StateWriter& out) const
+template <class IO, class Self>
+void CoupledWorld::state_fields(IO& io, Self& s)
 {
-    out.tag("coupling");
-    out.value<std::uint64_t>(bodies_.size());
-    for (std::size_t k = 0; k < bodies_.size(); ++k) {
-        out.value(bodies_[k].applied_force_N);
-        out.value(bodies_[k].applied_torque_N_m);
-    }
-    out.array(before_);
-    out.array(after_);
-    out.array(spin_rad_);
-    out.array(force_sum_);
-    out.array(torque_sum_);
-    out.value<std::int32_t>(samples_);
-    out.value<std::uint8_t>(started_ ? 1 : 0);
-    out.value(rigid_seconds_);
-    out.value(surface_seconds_);
-    out.array(watch_);
-    out.value<std::int32_t>(hold_steps_);
-    out.value(guarded_steps_);
-    out.value(runaways_caught_);
+    io.tag("coupling");
+    io.count(s.bodies_.size(), "coupled bodies");
+    for (auto& b : s.bodies_) io(b.applied_force_N, b.applied_torque_N_m);
+    io(s.before_, s.after_, s.spin_rad_, s.force_sum_, s.torque_sum_, s.samples_, s.started_, s.rigid_seconds_,
+       s.surface_seconds_, s.watch_, s.hold_steps_, s.guarded_steps_, s.runaways_caught_);
 }
+
+void CoupledWorld::write_state(StateWriter& out) const { state_fields(out, *this); }
 
 void CoupledWorld::read_state(StateReader& in)
 {
-    in.tag("coupling");
-    const auto n = in.value<std::uint64_t>();
-    if (n != bodies_.size()) in.fail(concat("the checkpoint couples ", n, " bodies, the world built from its scenario ", bodies_.size()));
-    for (CoupledBody& b : bodies_) {
-        b.applied_force_N = in.value<Vec3>();
-        b.applied_torque_N_m = in.value<Vec3>();
-    }
-    in.array(before_);
-    in.array(after_);
-    in.array(spin_rad_);
-    in.array(force_sum_);
-    in.array(torque_sum_);
-    for (std::size_t size : {before_.size(), after_.size(), spin_rad_.size(), force_sum_.size(), torque_sum_.size()})
-        if (size != bodies_.size()) in.fail("coupling arrays of another number of bodies");
-    samples_ = in.value<std::int32_t>();
-    started_ = in.value<std::uint8_t>() != 0;
-    rigid_seconds_ = in.value<double>();
-    surface_seconds_ = in.value<double>();
-    in.array(watch_);
-    if (watch_.size() != bodies_.size()) in.fail("runaway-guard records of another number of bodies");
-    hold_steps_ = in.value<std::int32_t>();
-    guarded_steps_ = in.value<std::uint64_t>();
-    runaways_caught_ = in.value<std::uint64_t>();
+    state_fields(in, *this);
+    for (std::size_t size : {before_.size(), after_.size(), spin_rad_.size(), force_sum_.size(), torque_sum_.size(), watch_.size()})
+        if (size != bodies_.size()) in.fail("coupling or runaway-guard arrays of another number of bodies");
     checked_bodies_ = 0;  // checked again before the next step
 }
 

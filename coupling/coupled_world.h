@@ -164,6 +164,9 @@ public:
     double kinetic_energy_J() const;
 
 private:
+    /// The checkpoint's fields, listed once for writing and reading (core/state_io.h).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     struct Pose {
         Mat3 rotation;
         Vec3 origin_m, centre_m;

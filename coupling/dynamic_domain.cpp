@@ -172,25 +172,21 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     }
 }
 
-void DynamicDomain::write_state(StateWriter& out) const
+template <class IO, class Self>
+void DynamicDomain::state_fields(IO& io, Self& s)
 {
-    out.tag("dynamic-domain");
-    out.array(sphere_rest_s_);
-    out.array(rock_rest_s_);
-    out.value<std::uint64_t>(frozen_spheres_);
-    out.value<std::uint64_t>(frozen_rocks_);
+    io.tag("dynamic-domain");
+    io(s.sphere_rest_s_, s.rock_rest_s_, s.frozen_spheres_, s.frozen_rocks_);
 }
+
+void DynamicDomain::write_state(StateWriter& out) const { state_fields(out, *this); }
 
 void DynamicDomain::read_state(StateReader& in)
 {
-    in.tag("dynamic-domain");
-    in.array(sphere_rest_s_);
-    in.array(rock_rest_s_);
+    state_fields(in, *this);
     for (const auto* v : {&sphere_rest_s_, &rock_rest_s_})
         for (double t : *v)
             if (!(t >= 0.0) || !std::isfinite(t)) in.fail(concat("a time at rest of ", t, " s; expected a finite value >= 0"));
-    frozen_spheres_ = in.value<std::uint64_t>();
-    frozen_rocks_ = in.value<std::uint64_t>();
 }
 
 }  // namespace dipper::coupling

@@ -46,6 +46,9 @@ public:
     void read_state(StateReader& in);
 
 private:
+    /// The checkpoint's fields, listed once for writing and reading (core/state_io.h).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     /// The cells (margin_m wide, or wider where the bodies spread far) that hold moving things, and those next to them.
     void mark(const Vec3& lo_m, const Vec3& hi_m);
     std::size_t cell_index(const Vec3& p) const;

@@ -375,10 +375,10 @@ void save_state(const CoupledWorld& world, const std::string& path, double cut_a
 
 namespace {
 
-/// Reads a state file line by line with errors that name the file and line.
-class StateReader {
+/// Reads a bed's text file line by line with errors that name the file and line.
+class BedFileReader {
 public:
-    explicit StateReader(const std::string& path) : path_(path), in_(path)
+    explicit BedFileReader(const std::string& path) : path_(path), in_(path)
     {
         if (!in_) throw InputError(concat("cannot open state file '", path, "'"));
     }
@@ -417,7 +417,7 @@ private:
 LoadedState load_state(CoupledWorld& world, const std::string& path, const KeepFilter& keep)
 {
     LoadedState loaded;
-    StateReader in(path);
+    BedFileReader in(path);
     {
         auto s = in.line("the header");
         std::string magic;

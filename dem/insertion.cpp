@@ -265,30 +265,29 @@ std::size_t Pourer::update(World& world)
     return added;
 }
 
+template <class IO, class Self>
+void Pourer::state_fields(IO& io, Self& s, std::string& random)
+{
+    io.tag("pourer");
+    io(s.radii_, s.next_, s.poured_mass_kg_, s.start_time_s_, random);
+}
+
 void Pourer::write_state(StateWriter& out) const
 {
-    out.tag("pourer");
-    out.array(radii_);
-    out.value<std::uint64_t>(next_);
-    out.value(poured_mass_kg_);
-    out.value(start_time_s_);
-    std::ostringstream random;
-    random << random_;
-    out.text(random.str());
+    std::ostringstream text;
+    text << random_;
+    std::string random = text.str();
+    state_fields(out, *this, random);
 }
 
 void Pourer::read_state(StateReader& in)
 {
-    in.tag("pourer");
-    in.array(radii_);
-    const auto next = in.value<std::uint64_t>();
-    if (next > radii_.size()) in.fail("a pour further along than it has particles");
-    next_ = static_cast<std::size_t>(next);
-    poured_mass_kg_ = in.value<double>();
-    start_time_s_ = in.value<double>();
-    std::istringstream random(in.text());
-    random >> random_;
-    if (!random) in.fail("an unreadable random state");
+    std::string random;
+    state_fields(in, *this, random);
+    if (next_ > radii_.size()) in.fail("a pour further along than it has particles");
+    std::istringstream text(random);
+    text >> random_;
+    if (!text) in.fail("an unreadable random state");
 }
 
 }  // namespace dipper::dem

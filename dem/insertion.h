@@ -104,6 +104,8 @@ public:
     void read_state(StateReader& in);
 
 private:
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s, std::string& random);
     BoxRegion region_;
     MaterialIndex material_;
     double mass_flow_kg_per_s_;

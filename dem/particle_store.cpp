@@ -87,26 +87,20 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order)
     apply_order(frozen, order, sf);
 }
 
-void ParticleStore::write_state(StateWriter& out) const
+template <class IO, class Self>
+void ParticleStore::state_fields(IO& io, Self& s)
 {
-    out.tag("particles");
-    for (const auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m}) out.array(*v);
-    for (const auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) out.array(*v);
-    out.array(material);
-    out.array(id);
-    out.array(frozen);
-    out.value(next_id_);
+    io.tag("particles");
+    io(s.position_m, s.velocity_m_per_s, s.angular_velocity_rad_per_s, s.force_N, s.torque_N_m);
+    io(s.radius_m, s.mass_kg, s.inverse_mass_per_kg, s.inverse_inertia_per_kg_m2);
+    io(s.material, s.id, s.frozen, s.next_id_);
 }
+
+void ParticleStore::write_state(StateWriter& out) const { state_fields(out, *this); }
 
 void ParticleStore::read_state(StateReader& in, const MaterialTable& materials)
 {
-    in.tag("particles");
-    for (auto* v : {&position_m, &velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m}) in.array(*v);
-    for (auto* v : {&radius_m, &mass_kg, &inverse_mass_per_kg, &inverse_inertia_per_kg_m2}) in.array(*v);
-    in.array(material);
-    in.array(id);
-    in.array(frozen);
-    next_id_ = in.value<std::uint32_t>();
+    state_fields(in, *this);
     const std::size_t n = position_m.size();
     for (const auto* v : {&velocity_m_per_s, &angular_velocity_rad_per_s, &force_N, &torque_N_m})
         if (v->size() != n) in.fail("particle arrays of different lengths");

@@ -54,6 +54,9 @@ public:
     std::vector<std::uint8_t> frozen;
 
 private:
+    /// The checkpoint's fields, listed once for writing and reading (core/state_io.h).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     std::uint32_t next_id_ = 0;
 };
 

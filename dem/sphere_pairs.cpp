@@ -307,20 +307,17 @@ std::vector<PairContactView> SpherePairs::contacts(const ParticleStore& p) const
     return out;
 }
 
-void SpherePairs::write_state(StateWriter& out) const
+template <class IO, class Self>
+void SpherePairs::state_fields(IO& io, Self& s)
 {
-    out.array(pair_i_);
-    out.array(pair_j_);
-    out.array(history_);
-    out.array(touching_);
+    io(s.pair_i_, s.pair_j_, s.history_, s.touching_);
 }
+
+void SpherePairs::write_state(StateWriter& out) const { state_fields(out, *this); }
 
 void SpherePairs::read_state(StateReader& in, std::size_t particles)
 {
-    in.array(pair_i_);
-    in.array(pair_j_);
-    in.array(history_);
-    in.array(touching_);
+    state_fields(in, *this);
     ++version_;
     // indices must stay inside the arrays they index (a corrupt file must not crash the run)
     if (pair_j_.size() != pair_i_.size() || history_.size() != pair_i_.size() || touching_.size() != pair_i_.size())

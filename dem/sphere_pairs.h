@@ -86,6 +86,8 @@ public:
     void read_state(StateReader& in, std::size_t particles);
 
 private:
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     std::vector<std::uint32_t> pair_i_, pair_j_;
     std::vector<ContactHistory> history_;
     std::vector<std::uint8_t> touching_;

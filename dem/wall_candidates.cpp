@@ -264,16 +264,11 @@ void WallCandidates::touching(std::uint32_t i, const Vec3& x, double r, const Wa
     }
 }
 
-void WallCandidates::write(StateWriter& out) const
-{
-    out.array(start_);
-    out.array(all_);
-}
+void WallCandidates::write_state(StateWriter& out) const { out(start_, all_); }
 
-void WallCandidates::read(StateReader& in, std::size_t planes, const std::vector<MeshWall>& meshes)
+void WallCandidates::read_state(StateReader& in, std::size_t planes, const std::vector<MeshWall>& meshes)
 {
-    in.array(start_);
-    in.array(all_);
+    in(start_, all_);
     if (!start_.empty() && start_.back() != all_.size()) in.fail("wall candidate index mismatch");
     if (!std::is_sorted(start_.begin(), start_.end())) in.fail("a wall contact or candidate index that does not ascend");
     for (const MeshCandidate& c : all_) {

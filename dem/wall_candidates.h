@@ -66,11 +66,11 @@ public:
     /// that is locally closest to the centre.
     void touching(std::uint32_t i, const Vec3& x, double r, const WallSet& walls, std::vector<WallHit>& hits) const;
 
-    void write(StateWriter& out) const;
-    /// Reads what write wrote and checks its indices against the walls (a corrupt file must not crash a run);
+    void write_state(StateWriter& out) const;
+    /// Reads what write_state wrote and checks its indices against the walls (a corrupt file must not crash a run);
     /// call split afterwards.
-    void read(StateReader& in, std::size_t planes, const std::vector<MeshWall>& meshes);
-    /// The indices' check of read: the lists are for `n` particles, or at most n while `more_may_come`.
+    void read_state(StateReader& in, std::size_t planes, const std::vector<MeshWall>& meshes);
+    /// The indices' check of read_state: the lists are for `n` particles, or at most n while `more_may_come`.
     bool sized_for(std::size_t n, bool more_may_come) const
     {
         return more_may_come ? start_.size() <= n + 1 : start_.size() == n + 1;

@@ -170,6 +170,9 @@ public:
     const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
 
 private:
+    /// The checkpoint's fields, listed once for writing and reading (core/state_io.h).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     struct WallRef { bool is_mesh; int index; };
 
     void sum_wall_reactions();

@@ -385,26 +385,78 @@ double RigidWorld::time_s() const { return impl_->time_s; }
 
 namespace {
 
-void write_transform(StateWriter& out, const btTransform& t)
+/// A pose as the checkpoint holds it: the basis row by row, then the origin.
+template <class IO>
+void transform_field(IO& io, btTransform& t)
 {
+    Mat3 basis;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) out.value<double>(t.getBasis()[i][j]);
-    out.value(from_bt(t.getOrigin()));
+        for (int j = 0; j < 3; ++j) basis.m[i][j] = t.getBasis()[i][j];
+    Vec3 origin = from_bt(t.getOrigin());
+    io(basis, origin);
+    if constexpr (IO::reading) {
+        btMatrix3x3 b;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) b[i][j] = basis.m[i][j];
+        t = btTransform(b, to_bt(origin));
+    }
 }
 
-btTransform read_transform(StateReader& in)
+/// Bullet's vectors as the checkpoint holds them.
+template <class IO, class Vectors>
+void vectors_field(IO& io, Vectors& v)
 {
-    btMatrix3x3 basis;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) basis[i][j] = in.value<double>();
-    return btTransform(basis, to_bt(in.value<Vec3>()));
+    std::vector<Vec3> plain;
+    for (const btVector3& x : v) plain.push_back(from_bt(x));
+    io(plain);
+    if constexpr (IO::reading) {
+        v.clear();
+        for (const Vec3& x : plain) v.push_back(to_bt(x));
+    }
 }
 
-std::vector<Vec3> as_vec3s(const std::vector<btVector3>& v)
+/// The rigid world's checkpoint fields, listed once for writing and reading (core/state_io.h): time and
+/// step, each body's pose and velocities (a kinematic part's last pose), the frozen flags, the contact
+/// forces, the velocities before the last step and the shovel. Reading checks each body's name and
+/// sets the poses; the frozen flags are returned for read_state to apply.
+template <class IO, class Impl>
+void rigid_state_fields(IO& io, Impl& w, std::vector<std::uint8_t>& frozen)
 {
-    std::vector<Vec3> out;
-    for (const btVector3& x : v) out.push_back(from_bt(x));
-    return out;
+    io.tag("rigid world");
+    io.count(w.bodies.size(), "rigid bodies");
+    io(w.time_s, w.step_count, w.step_s);
+    for (auto& b : w.bodies) {
+        std::string name = b->name;
+        io(name);
+        if constexpr (IO::reading)
+            if (name != b->name) io.fail(concat("rigid body '", name, "' where the world has '", b->name, "'"));
+        if (b->body) {
+            btTransform t = b->body->getWorldTransform();
+            transform_field(io, t);
+            Vec3 v = from_bt(b->body->getLinearVelocity()), omega = from_bt(b->body->getAngularVelocity());
+            io(v, omega);
+            if constexpr (IO::reading) {
+                b->body->setWorldTransform(t);
+                b->body->setInterpolationWorldTransform(t);
+                if (b->motion) b->motion->setWorldTransform(t);
+                b->body->setLinearVelocity(to_bt(v));
+                b->body->setAngularVelocity(to_bt(omega));
+                b->body->setInterpolationLinearVelocity(to_bt(v));
+                b->body->setInterpolationAngularVelocity(to_bt(omega));
+            }
+        } else {
+            btTransform t = b->previous_pose;
+            transform_field(io, t);
+            if constexpr (IO::reading) b->previous_pose = t;
+        }
+    }
+    io(frozen, w.contact_force);
+    vectors_field(io, w.velocity_before);
+    vectors_field(io, w.spin_before);
+    bool shovel = w.shovel != nullptr;
+    io(shovel);
+    if constexpr (IO::reading)
+        if (shovel != (w.shovel != nullptr)) io.fail("the checkpoint and the world differ in having a rope shovel");
 }
 
 }  // namespace
@@ -412,61 +464,18 @@ std::vector<Vec3> as_vec3s(const std::vector<btVector3>& v)
 void RigidWorld::write_state(StateWriter& out) const
 {
     const Impl& w = *impl_;
-    out.tag("rigid world");
-    out.value<std::uint64_t>(w.bodies.size());
-    out.value(w.time_s);
-    out.value(w.step_count);
-    out.value(w.step_s);
-    for (const auto& b : w.bodies) {
-        out.text(b->name);
-        if (b->body) {
-            write_transform(out, b->body->getWorldTransform());
-            out.value(from_bt(b->body->getLinearVelocity()));
-            out.value(from_bt(b->body->getAngularVelocity()));
-        } else {
-            write_transform(out, b->previous_pose);
-        }
-    }
     std::vector<std::uint8_t> frozen;
     for (const auto& b : w.bodies) frozen.push_back(b->frozen ? 1 : 0);
-    out.array(frozen);
-    out.array(w.contact_force);
-    out.array(as_vec3s(w.velocity_before));
-    out.array(as_vec3s(w.spin_before));
-    out.value<std::uint8_t>(w.shovel ? 1 : 0);
+    rigid_state_fields(out, w, frozen);
     if (w.shovel) write_shovel_state(*w.shovel, out);
 }
 
 void RigidWorld::read_state(StateReader& in)
 {
     Impl& w = *impl_;
-    in.tag("rigid world");
-    const auto n = in.value<std::uint64_t>();
-    if (n != w.bodies.size())
-        in.fail(concat("the checkpoint has ", n, " rigid bodies, the world built from its scenario ", w.bodies.size()));
-    w.time_s = in.value<double>();
-    w.step_count = in.value<std::uint64_t>();
-    w.step_s = in.value<double>();
-    if (!(w.step_s >= 0.0) || !std::isfinite(w.step_s)) in.fail(concat("a last rigid step of ", w.step_s, " s"));
-    for (auto& b : w.bodies) {
-        const std::string name = in.text();
-        if (name != b->name) in.fail(concat("rigid body '", name, "' where the world has '", b->name, "'"));
-        if (b->body) {
-            const btTransform t = read_transform(in);
-            const btVector3 v = to_bt(in.value<Vec3>()), omega = to_bt(in.value<Vec3>());
-            b->body->setWorldTransform(t);
-            b->body->setInterpolationWorldTransform(t);
-            if (b->motion) b->motion->setWorldTransform(t);
-            b->body->setLinearVelocity(v);
-            b->body->setAngularVelocity(omega);
-            b->body->setInterpolationLinearVelocity(v);
-            b->body->setInterpolationAngularVelocity(omega);
-        } else {
-            b->previous_pose = read_transform(in);
-        }
-    }
     std::vector<std::uint8_t> frozen;
-    in.array(frozen);
+    rigid_state_fields(in, w, frozen);
+    if (!(w.step_s >= 0.0) || !std::isfinite(w.step_s)) in.fail(concat("a last rigid step of ", w.step_s, " s"));
     if (frozen.size() != w.bodies.size()) in.fail("a frozen flag for each rigid body");
     for (std::size_t k = 0; k < frozen.size(); ++k) {
         if (frozen[k] > 1 || (frozen[k] && !w.bodies[k]->is_rock()))
@@ -481,17 +490,7 @@ void RigidWorld::read_state(StateReader& in)
             w.bodies[k]->body->setInterpolationAngularVelocity(omega);
         }
     }
-    in.array(w.contact_force);
-    std::vector<Vec3> before, spin;
-    in.array(before);
-    in.array(spin);
-    w.velocity_before.clear();
-    w.spin_before.clear();
-    for (const Vec3& x : before) w.velocity_before.push_back(to_bt(x));
-    for (const Vec3& x : spin) w.spin_before.push_back(to_bt(x));
-    const bool shovel = in.value<std::uint8_t>() != 0;
-    if (shovel != (w.shovel != nullptr)) in.fail("the checkpoint and the world differ in having a rope shovel");
-    if (shovel) read_shovel_state(*w.shovel, in, w.step_s);
+    if (w.shovel) read_shovel_state(*w.shovel, in, w.step_s);
     if (w.contact_force.size() != w.bodies.size()) in.fail("rigid contact forces of another number of bodies");
 }
 

@@ -530,45 +530,39 @@ void shovel_after_step(RigidWorld::Impl& w)
     read_pose(s);
 }
 
-void write_shovel_state(const ShovelState& s, StateWriter& out)
+namespace {
+
+/// The shovel's checkpoint fields, listed once for writing and reading (core/state_io.h): its joints, the
+/// ropes, the force window and the last reading.
+template <class IO, class State>
+void shovel_state_fields(IO& io, State& s)
 {
-    out.tag("rope shovel");
+    io.tag("rope shovel");
     for (int j = 0; j < 4; ++j) {
-        out.value<double>(s.body->getJointPos(j));
-        out.value<double>(s.body->getJointVel(j));
+        double position = s.body->getJointPos(j), velocity = s.body->getJointVel(j);
+        io(position, velocity);
+        if constexpr (IO::reading) {
+            s.body->setJointPos(j, position);
+            s.body->setJointVel(j, velocity);
+        }
     }
-    for (int r = 0; r < 2; ++r) {
-        out.value(s.previous_length[r]);
-        out.value(s.tension[r]);
-    }
-    out.value<std::uint8_t>(s.started ? 1 : 0);
-    out.value<std::uint64_t>(s.window.size());
-    for (const auto& x : s.window) out.value(x);
-    out.value(s.reading);
+    for (int r = 0; r < 2; ++r) io(s.previous_length[r], s.tension[r]);
+    std::vector<ShovelState::Sample> window(s.window.begin(), s.window.end());
+    io(s.started, window, s.reading);
+    if constexpr (IO::reading) s.window.assign(window.begin(), window.end());
 }
+
+}  // namespace
+
+void write_shovel_state(const ShovelState& s, StateWriter& out) { shovel_state_fields(out, s); }
 
 void read_shovel_state(ShovelState& s, StateReader& in, double last_step_s)
 {
-    in.tag("rope shovel");
-    btMultiBody& mb = *s.body;
-    for (int j = 0; j < 4; ++j) {
-        mb.setJointPos(j, in.value<double>());
-        mb.setJointVel(j, in.value<double>());
-    }
+    shovel_state_fields(in, s);
     btAlignedObjectArray<btQuaternion> scratch_q;
     btAlignedObjectArray<btVector3> scratch_m;
-    mb.forwardKinematics(scratch_q, scratch_m);
-    mb.updateCollisionObjectWorldTransforms(scratch_q, scratch_m);
-    for (int r = 0; r < 2; ++r) {
-        s.previous_length[r] = in.value<double>();
-        s.tension[r] = in.value<double>();
-    }
-    s.started = in.value<std::uint8_t>() != 0;
-    const auto n = in.value<std::uint64_t>();
-    if (n > in.left() / sizeof(ShovelState::Sample)) in.fail("a force window longer than the file");
-    s.window.clear();
-    for (std::uint64_t k = 0; k < n; ++k) s.window.push_back(in.value<ShovelState::Sample>());
-    s.reading = in.value<ShovelReading>();
+    s.body->forwardKinematics(scratch_q, scratch_m);
+    s.body->updateCollisionObjectWorldTransforms(scratch_q, scratch_m);
     place_base(s, s.reading.time_s, last_step_s);
 }
 

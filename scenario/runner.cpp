@@ -34,6 +34,22 @@ namespace {
 
 constexpr const char* kCheckpointMagic = "dipper-checkpoint 6";
 
+/// The checkpoint's "run" section: the scenario as it was read, and the thread count (same threads, same bits).
+struct RunHeader {
+    std::string text, source, base_dir;
+    std::int32_t threads = 1;
+
+    template <class IO>
+    void fields(IO& io)
+    {
+        io.tag("run");
+        io(text, source, base_dir, threads);
+    }
+};
+
+/// The entries of each ParaView series (time, file), in the order all_series() gives them.
+using SeriesEntries = std::vector<std::vector<std::pair<double, std::string>>>;
+
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int signal) { g_signal = signal; }
 
@@ -119,26 +135,10 @@ public:
     void start_from(StateReader& in)
     {
         adopt(std::make_unique<Simulation>(scenario_, 0, in));
-        in.tag("outputs");
-        next_csv_s_ = in.value<double>();
-        next_vtk_s_ = in.value<double>();
-        next_checkpoint_s_ = in.value<double>();
-        snapshot_index_ = in.value<int>();
-        wall_seconds_before_ = in.value<double>();
-        steps_before_ = in.value<std::uint64_t>();
-        pile_ = in.value<coupling::LoadedState>();
-        const auto csv_bytes = in.value<std::uint64_t>();
         walls_ = all_walls();
-        const std::size_t series = 1 + walls_.size() + (sim_ ? 1 + sim_->wear().size() : 0);
-        std::vector<std::vector<std::pair<double, std::string>>> entries(series);
-        for (auto& e : entries) {
-            const auto n = in.value<std::uint64_t>();
-            if (n > in.left()) in.fail("too many snapshot entries");
-            for (std::uint64_t k = 0; k < n; ++k) {
-                const double t = in.value<double>();
-                e.emplace_back(t, in.text());
-            }
-        }
+        std::uint64_t csv_bytes = 0;
+        SeriesEntries entries(1 + walls_.size() + (sim_ ? 1 + sim_->wear().size() : 0));
+        output_fields(in, wall_seconds_before_, steps_before_, csv_bytes, entries);
         in.finish();
         open_outputs(true, csv_bytes);
         std::size_t k = 0;
@@ -151,6 +151,24 @@ public:
             if (rocks_pvd_) rocks_pvd_->restore(entries[k]);
             ++k;
             for (const auto& w : wear_pvd_) w->restore(entries[k++]);
+        }
+    }
+
+    /// The checkpoint's "outputs" section, listed once for writing and reading: the output schedule, the wall
+    /// clock and steps so far, the pile, the CSV's length and each ParaView series' entries.
+    template <class IO>
+    void output_fields(IO& io, double& wall_s, std::uint64_t& steps, std::uint64_t& csv_bytes, SeriesEntries& series)
+    {
+        io.tag("outputs");
+        io(next_csv_s_, next_vtk_s_, next_checkpoint_s_, snapshot_index_, wall_s, steps, pile_, csv_bytes);
+        for (auto& entries : series) {
+            std::size_t n = entries.size();
+            io(n);
+            if constexpr (IO::reading) {
+                if (n > io.left()) io.fail("too many snapshot entries");
+                entries.resize(n);
+            }
+            for (auto& [t, file] : entries) io(t, file);
         }
     }
 
@@ -406,36 +424,22 @@ private:
     void checkpoint()
     {
         StateWriter out;
-        out.tag("run");
-        out.text(scenario_.text);
-        out.text(scenario_.source);
-        out.text(scenario_.base_dir);
-        out.value<std::int32_t>(world_->threads());
+        RunHeader header{scenario_.text, scenario_.source, scenario_.base_dir, world_->threads()};
+        header.fields(out);
         model_->write_state(out);
-        out.tag("outputs");
-        out.value(next_csv_s_);
-        out.value(next_vtk_s_);
-        out.value(next_checkpoint_s_);
-        out.value(snapshot_index_);
-        out.value(wall_seconds_now());
-        out.value<std::uint64_t>(world_->step_count());
-        out.value(pile_);
+        double wall_s = wall_seconds_now();
+        std::uint64_t steps = world_->step_count();
         csv_.flush();
-        out.value<std::uint64_t>(static_cast<std::uint64_t>(csv_.tellp()));
-        const auto write_entries = [&](const dem::PvdCollection* c) {
-            const auto& e = c ? c->entries() : std::vector<std::pair<double, std::string>>{};
-            out.value<std::uint64_t>(e.size());
-            for (const auto& [t, f] : e) {
-                out.value(t);
-                out.text(f);
-            }
-        };
-        write_entries(particles_pvd_.get());
-        for (const auto& w : wall_pvd_) write_entries(w.get());
+        auto csv_bytes = static_cast<std::uint64_t>(csv_.tellp());
+        SeriesEntries series;
+        const auto add = [&](const dem::PvdCollection* c) { series.push_back(c ? c->entries() : SeriesEntries::value_type{}); };
+        add(particles_pvd_.get());
+        for (const auto& w : wall_pvd_) add(w.get());
         if (sim_) {
-            write_entries(rocks_pvd_.get());
-            for (const auto& w : wear_pvd_) write_entries(w.get());
+            add(rocks_pvd_.get());
+            for (const auto& w : wear_pvd_) add(w.get());
         }
+        output_fields(out, wall_s, steps, csv_bytes, series);
         // the new file first, then the old one becomes the previous: a good checkpoint always exists
         const fs::path dir(dir_);
         out.save((dir / "checkpoint.next.bin").string(), kCheckpointMagic);
@@ -673,11 +677,11 @@ OpenCheckpoint open_checkpoint(const std::string& out_dir, const std::string& ch
                                                : std::string()));
     }
     StateReader& in = *c.in;
-    in.tag("run");
-    const std::string text = in.text(), source = in.text(), base_dir = in.text();
-    c.threads = in.value<std::int32_t>();
+    RunHeader header;
+    header.fields(in);
+    c.threads = header.threads;
     if (c.threads < 1 || c.threads > 1024) in.fail(concat("a thread count of ", c.threads, "; expected 1 to 1024"));
-    c.scenario = parse_scenario(text, source, base_dir);
+    c.scenario = parse_scenario(header.text, header.source, header.base_dir);
     return c;
 }
 

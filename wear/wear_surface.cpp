@@ -198,29 +198,22 @@ WearSurface WearSurface::scaled(double factor) const
     return s;
 }
 
-void WearSurface::write_state(StateWriter& out) const
+template <class IO, class Self>
+void WearSurface::state_fields(IO& io, Self& s)
 {
-    out.tag("wear surface");
-    out.text(name_);
-    out.value(time_s_);
-    out.array(volume_m3_);
-    out.array(normal_impulse_N_s_);
-    out.array(tangential_impulse_N_s_);
-    out.array(contact_steps_);
-    out.array(impacts_);
+    io.tag("wear surface");
+    std::string name = s.name_;
+    io(name);
+    if constexpr (IO::reading)
+        if (name != s.name_) io.fail(concat("wear surface '", name, "' where the run has '", s.name_, "'"));
+    io(s.time_s_, s.volume_m3_, s.normal_impulse_N_s_, s.tangential_impulse_N_s_, s.contact_steps_, s.impacts_);
 }
+
+void WearSurface::write_state(StateWriter& out) const { state_fields(out, *this); }
 
 void WearSurface::read_state(StateReader& in)
 {
-    in.tag("wear surface");
-    const std::string name = in.text();
-    if (name != name_) in.fail(concat("wear surface '", name, "' where the run has '", name_, "'"));
-    time_s_ = in.value<double>();
-    in.array(volume_m3_);
-    in.array(normal_impulse_N_s_);
-    in.array(tangential_impulse_N_s_);
-    in.array(contact_steps_);
-    in.array(impacts_);
+    state_fields(in, *this);
     const std::size_t n = mesh_.triangle_count();
     if (volume_m3_.size() != n || normal_impulse_N_s_.size() != n || tangential_impulse_N_s_.size() != n ||
         contact_steps_.size() != n || impacts_.size() != n)

@@ -90,6 +90,9 @@ public:
     WearSurface scaled(double factor) const;
 
 private:
+    /// The checkpoint's fields, listed once for writing and reading (core/state_io.h).
+    template <class IO, class Self>
+    static void state_fields(IO& io, Self& s);
     std::string name_;
     meshes::TriangleMesh mesh_;
     WearLaw law_;
