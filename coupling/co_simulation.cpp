@@ -75,7 +75,7 @@ CoSimulation::CoSimulation(std::unique_ptr<dem::World> dem, CoSimulationSettings
     // FE truck-DE 0.85; DE-remaining 0, the frictionless walls of calibration boxes)
     rigid_->add_material("truck");
     rigid_->add_material("steel");
-    rigid_->set_pair("rock", "truck", 0.85, 0.0);
+    rigid_->set_pair("rock", "truck", rigid::kTable2RockFriction.truck, 0.0);
     rigid_->set_pair("rock", "steel", 0.0, 0.0);
     for (const RockPair& p : settings.rock_pairs) rigid_->set_pair(p.a, p.b, p.friction, p.restitution);
     coupled_ = std::make_unique<coupling::CoupledWorld>(*dem_, *rigid_, settings.coupling);

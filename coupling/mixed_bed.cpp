@@ -18,9 +18,9 @@ namespace dipper::coupling {
 
 void MixedDistribution::validate(const std::string& where) const
 {
-    require_positive(sphere_radius_m, "sphere_radius_m", where);
-    require_in_range(sphere_mass_fraction, 0.0, 1.0, "sphere_mass_fraction", where);
-    double sum = sphere_mass_fraction;
+    require_positive(spheres.radius_m, "the spheres' radius_m", where);
+    require_in_range(spheres.mass_fraction, 0.0, 1.0, "the spheres' mass_fraction", where);
+    double sum = spheres.mass_fraction;
     for (std::size_t c = 0; c < rocks.size(); ++c) {
         const std::string at = concat(where, ", rock class ", c);
         require_positive(rocks[c].size_m, "size_m", at);
@@ -210,8 +210,8 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
     dem::require_mass_fits(total_mass_kg, materials.density_kg_per_m3, lo, hi, where);
     {
         // a rock counted as the sphere of its size, as the classes are made below
-        double count = distribution.sphere_mass_fraction * total_mass_kg /
-                       dem::sphere_mass_kg(distribution.sphere_radius_m, materials.density_kg_per_m3);
+        double count = distribution.spheres.mass_fraction * total_mass_kg /
+                       dem::sphere_mass_kg(distribution.spheres.radius_m, materials.density_kg_per_m3);
         for (const RockClass& rc : distribution.rocks)
             count += rc.mass_fraction * total_mass_kg / dem::sphere_mass_kg(0.5 * rc.size_m, materials.density_kg_per_m3);
         if (!(count <= dem::kMaxFillParticles))
@@ -233,13 +233,13 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
     std::vector<PlacedRock> placed;
     double largest_class_m = 0.0;
     for (const RockClass& rc : distribution.rocks) largest_class_m = std::max(largest_class_m, rc.size_m);
-    RockGrid placed_grid(lo, std::max(largest_class_m, 2.0 * distribution.sphere_radius_m));
+    RockGrid placed_grid(lo, std::max(largest_class_m, 2.0 * distribution.spheres.radius_m));
     for (const RockRecord& r : world.rocks()) {
         const rigid::BodyState s = world.rigid().state(r.body);
         placed.push_back(place(r.shape, s.rotation, s.position_m));
         placed_grid.add(static_cast<std::uint32_t>(placed.size() - 1), placed.back().centre, placed.back().radius);
     }
-    const double rs = distribution.sphere_radius_m;
+    const double rs = distribution.spheres.radius_m;
     SphereGrid grid(lo, hi, 2.0 * std::max(rs, [&] {
                                    double m = 0.0;
                                    for (double r : dem.particles().radius_m) m = std::max(m, r);
@@ -302,7 +302,7 @@ MixedFillReport fill_mixed(CoupledWorld& world, const Vec3& lo, const Vec3& hi, 
 
     // spheres in the gaps; the rocks near each try found through the same grid
     const double sphere_mass = dem::sphere_mass_kg(rs, materials.density_kg_per_m3);
-    const auto sphere_count = static_cast<std::size_t>(std::llround(distribution.sphere_mass_fraction * total_mass_kg / sphere_mass));
+    const auto sphere_count = static_cast<std::size_t>(std::llround(distribution.spheres.mass_fraction * total_mass_kg / sphere_mass));
     const Vec3 s_lo = lo + Vec3{rs, rs, rs}, s_hi = hi - Vec3{rs, rs, rs};
     if (s_lo.x > s_hi.x || s_lo.y > s_hi.y || s_lo.z > s_hi.z)
         throw InputError(concat(where, ": the box is thinner than one sphere of radius ", rs, " m"));

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "coupling/coupled_world.h"
+#include "dem/insertion.h"
 
 #include <cstdint>
 #include <functional>
@@ -20,8 +21,7 @@ struct RockClass {
 
 /// Spheres of one radius and rock classes, by mass fraction (summing to 1 within 1e-6).
 struct MixedDistribution {
-    double sphere_radius_m = 0.1;
-    double sphere_mass_fraction = 0.37;
+    dem::SizeClass spheres{0.1, 0.37};
     std::vector<RockClass> rocks{{0.30, 0.10}, {0.40, 0.09}, {0.60, 0.19}, {0.85, 0.25}};
     double elongation_min = 1.0, elongation_max = 2.0;  ///< rock shapes (rigid::RockShape)
     int rock_point_count = 20;

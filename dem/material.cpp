@@ -106,17 +106,12 @@ MaterialTable MaterialTable::aitik_copper_ore(double particle_density_kg_per_m3)
     t.add({"steel", 0.0, 0.0, 0.0, true});
 
     const std::string src = "Aitik copper ore preset (thesis Table 2)";
-    // DE-DE: C_norm 0.05, C_tan 0.27, mu 0.9, mu_roll 0.05, D_n 0.9, D_t 0.75
-    t.set_pair("ore", "ore", {0.05, 0.27, 0.9, 0.05, 0.9, 0.75}, src);
-    // Ground-DE: mu 0.9, mu_roll 0.3; damping 1 where Table 2 is silent
-    t.set_pair("ore", "ground", {0.05, 0.27, 0.9, 0.3, 1.0, 1.0}, src);
-    // Bucket-DE: mu 0.53 (pin-on-disc, Hardox against Aitik rock), mu_roll 0.05
-    t.set_pair("ore", "bucket", {0.05, 0.27, 0.53, 0.05, 1.0, 1.0}, src);
-    // FE rocks-DE and FE truck-DE: mu 0.85
-    t.set_pair("ore", "rock", {0.05, 0.27, 0.85, 0.05, 1.0, 1.0}, src);
-    t.set_pair("ore", "truck", {0.05, 0.27, 0.85, 0.05, 1.0, 1.0}, src);
-    // DE-remaining: mu 0
-    t.set_pair("ore", "steel", {0.05, 0.27, 0.0, 0.0, 1.0, 1.0}, src);
+    t.set_pair("ore", "ore", table2::ore_ore, src);
+    t.set_pair("ore", "ground", table2::ore_ground, src);
+    t.set_pair("ore", "bucket", table2::ore_bucket, src);
+    t.set_pair("ore", "rock", table2::ore_rock, src);
+    t.set_pair("ore", "truck", table2::ore_truck, src);
+    t.set_pair("ore", "steel", table2::ore_steel, src);
     return t;
 }
 

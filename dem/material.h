@@ -33,6 +33,23 @@ struct PairCoefficients {
     double tangential_damping_ratio = 1.0;     ///< D_t: fraction of critical damping, 0..1
 };
 
+/// Thesis Paper A Table 2 as dipper's spheres see it, written once: the preset (MaterialTable::aitik_copper_ore),
+/// the tests and the benchmarks read these. Damping 1 where Table 2 gives none (the thesis damps fully).
+namespace table2 {
+/// DE-DE: C_norm 0.05, C_tan 0.27, mu 0.9, mu_roll 0.05, D_n 0.9, D_t 0.75
+inline constexpr PairCoefficients ore_ore{0.05, 0.27, 0.9, 0.05, 0.9, 0.75};
+/// Ground-DE: mu 0.9, mu_roll 0.3
+inline constexpr PairCoefficients ore_ground{0.05, 0.27, 0.9, 0.3, 1.0, 1.0};
+/// Bucket-DE: mu 0.53 (pin-on-disc, Hardox against Aitik rock), mu_roll 0.05
+inline constexpr PairCoefficients ore_bucket{0.05, 0.27, 0.53, 0.05, 1.0, 1.0};
+/// FE rocks-DE: mu 0.85
+inline constexpr PairCoefficients ore_rock{0.05, 0.27, 0.85, 0.05, 1.0, 1.0};
+/// FE truck-DE: mu 0.85
+inline constexpr PairCoefficients ore_truck{0.05, 0.27, 0.85, 0.05, 1.0, 1.0};
+/// DE-remaining: mu 0 (the frictionless walls of calibration boxes)
+inline constexpr PairCoefficients ore_steel{0.05, 0.27, 0.0, 0.0, 1.0, 1.0};
+}  // namespace table2
+
 /// The constant material model of a run: materials and a symmetric table of pair coefficients. Built
 /// and validated once; read-only (and so thread-safe) during the run.
 class MaterialTable {

@@ -54,8 +54,7 @@ int main(int argc, char** argv)
 
         // 3. the bed, clear of the dipper where it stands, and the dipper's wear (force-work law, thesis eq. 2.8)
         coupling::MixedDistribution bed;
-        bed.sphere_radius_m = 0.3;
-        bed.sphere_mass_fraction = 0.65;
+        bed.spheres = {0.3, 0.65};
         bed.rocks = {{0.85, 0.35}};
         const coupling::MixedMaterials materials{m.index_of("ore"), m.index_of("rock"), sim.rigid().material_index("rock"),
                                                  m.material(m.index_of("ore")).density_kg_per_m3};

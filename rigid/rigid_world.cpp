@@ -671,9 +671,9 @@ void add_aitik_copper_ore_materials(RigidWorld& w)
     w.add_material("rock");
     w.add_material("ground");
     w.add_material("bucket");
-    w.set_pair("rock", "rock", 0.85, 0.0);
-    w.set_pair("rock", "ground", 0.9, 0.0);
-    w.set_pair("rock", "bucket", 0.53, 0.0);
+    w.set_pair("rock", "rock", kTable2RockFriction.rock, 0.0);
+    w.set_pair("rock", "ground", kTable2RockFriction.ground, 0.0);
+    w.set_pair("rock", "bucket", kTable2RockFriction.bucket, 0.0);
 }
 
 }  // namespace dipper::rigid

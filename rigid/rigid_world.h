@@ -194,9 +194,17 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-/// Rock materials of the Aitik copper ore (thesis Paper A Table 2) as Bullet sees them: "rock", "ground",
-/// "bucket"; friction rock-rock 0.85, rock-ground 0.9, rock-bucket 0.53 (the Hardox pin-on-disc value).
-/// Table 2 gives no restitution; where it is silent the thesis damps fully, so restitution is 0.
+/// Thesis Paper A Table 2 as Bullet's rocks see it, written once: the preset, the tests and the benchmarks
+/// read these. Coulomb friction of a rock against another rock, the ground, the bucket (the Hardox
+/// pin-on-disc value) and the truck; Table 2 gives no restitution, and where it is silent the thesis damps
+/// fully, so restitution is 0.
+struct RockFriction {
+    double rock = 0.85, ground = 0.9, bucket = 0.53, truck = 0.85;
+};
+inline constexpr RockFriction kTable2RockFriction{};
+
+/// Rock materials of the Aitik copper ore as Bullet sees them: "rock", "ground", "bucket", with the
+/// friction of kTable2RockFriction and restitution 0.
 void add_aitik_copper_ore_materials(RigidWorld& world);
 
 }  // namespace dipper::rigid

@@ -58,10 +58,8 @@ void fill_rocks(const Scenario& s, coupling::CoSimulation& sim)
         const FillSpec& f = s.fills[k];
         if (f.rocks.empty()) continue;
         coupling::MixedDistribution d;
-        d.sphere_radius_m = f.sizes.classes[0].radius_m;
-        d.sphere_mass_fraction = f.sizes.classes[0].mass_fraction;
-        d.rocks.clear();
-        for (const RockClassSpec& c : f.rocks) d.rocks.push_back({c.size_m, c.mass_fraction});
+        d.spheres = f.sizes.classes[0];
+        d.rocks = f.rocks;
         d.elongation_max = f.rock_elongation_max;
         d.rock_point_count = f.rock_points;
         try {

@@ -198,7 +198,7 @@ FillSpec read_fill(const Scenario& s, const MapReader& r)
         r.fail("sizes", concat(fill.sizes.classes.size(), " sphere classes"), "one sphere class in a fill with rocks");
     double sum = fill.sizes.classes[0].mass_fraction;
     for (const MapReader& k : rocks) {
-        RockClassSpec c;
+        coupling::RockClass c;
         c.size_m = k.number("size_m");
         require_positive(c.size_m, "size_m", k.where("size_m"));
         c.mass_fraction = k.number("mass_fraction");

@@ -4,6 +4,7 @@
 
 #include "core/vec3.h"
 #include "coupling/co_simulation.h"
+#include "coupling/mixed_bed.h"
 #include "dem/insertion.h"
 #include "dem/material.h"
 #include "dem/pile.h"
@@ -48,14 +49,9 @@ struct ParticleSource {
     std::string where;  ///< file:line:col of the entry's mass_kg, for errors found when placing
 };
 
-/// One class of polyhedral rocks in a fill.
-struct RockClassSpec {
-    double size_m = 0.0, mass_fraction = 0.0;
-};
-
 /// Particles placed at t = 0: spheres only, or spheres of one size with rock classes (a mixed fill).
 struct FillSpec : ParticleSource {
-    std::vector<RockClassSpec> rocks;
+    std::vector<coupling::RockClass> rocks;
     double rock_elongation_max = 2.0;
     int rock_points = 20;  ///< points drawn per rock before its hull (rigid::RockShape::point_count)
 };

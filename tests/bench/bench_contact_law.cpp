@@ -36,7 +36,7 @@ Batch make_batch(bool slide)
     return b;
 }
 
-const PairCoefficients kOre{0.05, 0.27, 0.9, 0.05, 0.9, 0.75};
+const PairCoefficients kOre = table2::ore_ore;
 const double kKn = pair_normal_stiffness(37.5e9, 0.1, 37.5e9, 0.1, 0.05);
 const double kMass = 0.5 * 4.0 / 3.0 * M_PI * 1e-3 * 3700.0;
 

@@ -147,18 +147,18 @@ int main(int argc, char** argv)
 
     // Table 1 rock classes in their mass ratios; the sphere fraction follows from the two counts
     const double density = 3700.0, sphere_mass = density * 4.0 / 3.0 * M_PI * 1e-3;
-    const double sizes[4] = {0.3, 0.4, 0.6, 0.85}, table1[4] = {10, 9, 19, 25};
+    const std::vector<coupling::RockClass> table1 = coupling::MixedDistribution::thesis_table1().rocks;
     double per_rock_weight = 0.0, rock_count_weight = 0.0;
-    for (int c = 0; c < 4; ++c) {
-        const double one = density * M_PI / 6.0 * std::pow(sizes[c], 3);
-        rock_count_weight += table1[c] / one;
-        per_rock_weight += table1[c];
+    for (const coupling::RockClass& c : table1) {
+        const double one = density * M_PI / 6.0 * std::pow(c.size_m, 3);
+        rock_count_weight += c.mass_fraction / one;
+        per_rock_weight += c.mass_fraction;
     }
     const double rock_mass = rocks * per_rock_weight / rock_count_weight;  // total rock mass for `rocks` rocks
     const double total = rock_mass + spheres * sphere_mass;
     coupling::MixedDistribution d;
-    d.sphere_mass_fraction = spheres * sphere_mass / total;
-    for (int c = 0; c < 4; ++c) d.rocks[static_cast<std::size_t>(c)].mass_fraction = rock_mass / total * table1[c] / per_rock_weight;
+    d.spheres.mass_fraction = spheres * sphere_mass / total;
+    for (std::size_t c = 0; c < table1.size(); ++c) d.rocks[c].mass_fraction = rock_mass / total * table1[c].mass_fraction / per_rock_weight;
     const double solid_m3 = total / density;
     const double side = std::ceil(std::cbrt(solid_m3 / 0.3 / 0.9));  // loose fill at a solid fraction of 0.3, 0.9 as deep as wide
     const double height = solid_m3 / 0.3 / (side * side);

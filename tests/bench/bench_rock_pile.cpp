@@ -8,6 +8,7 @@
 // pile settles once. --pairs bullet steps hull pairs with Bullet's own convex-convex algorithm instead of
 // dipper's (RigidSettings::bullet_convex_pairs), for comparison. --threads: the narrow phase's threads
 // (RigidSettings::threads; the same pile to the bit on any number).
+#include "coupling/mixed_bed.h"
 #include "rigid/rigid_world.h"
 #include "rigid/rock_generator.h"
 #include "tests/bench/options.h"
@@ -75,14 +76,14 @@ int main(int argc, char** argv)
     RigidWorld w(settings);
     w.add_material("rock");
     w.add_material("ground");
-    w.set_pair("rock", "rock", 0.85, 0.0);
-    w.set_pair("rock", "ground", 0.9, 0.0);
+    w.set_pair("rock", "rock", kTable2RockFriction.rock, 0.0);
+    w.set_pair("rock", "ground", kTable2RockFriction.ground, 0.0);
     const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
 
     // size classes by count from the mass fractions (mass per rock ~ size^3)
-    const double sizes[4] = {0.3, 0.4, 0.6, 0.85}, mass_fraction[4] = {10, 9, 19, 25};
+    const std::vector<coupling::RockClass> table1 = coupling::MixedDistribution::thesis_table1().rocks;
     double weights[4], total = 0.0;
-    for (int c = 0; c < 4; ++c) total += weights[c] = mass_fraction[c] / std::pow(sizes[c], 3);
+    for (int c = 0; c < 4; ++c) total += weights[c] = table1[c].mass_fraction / std::pow(table1[c].size_m, 3);
     std::mt19937_64 rng(1);
     std::discrete_distribution<int> pick(weights, weights + 4);
     const int side = static_cast<int>(std::ceil(std::sqrt(rocks / 4.0)));
@@ -90,7 +91,7 @@ int main(int argc, char** argv)
     double weight = 0.0;
     for (int k = 0; k < rocks; ++k) {
         const int layer = k / (side * side), i = (k / side) % side, j = k % side;
-        const ConvexPolyhedron r = generate_rock({sizes[pick(rng)], 1.0, 2.0, point_count}, 1000 + static_cast<std::uint64_t>(k));
+        const ConvexPolyhedron r = generate_rock({table1[static_cast<std::size_t>(pick(rng))].size_m, 1.0, 2.0, point_count}, 1000 + static_cast<std::uint64_t>(k));
         const BodyId id = w.add_rock(r, 2700.0, 0, {i * spacing, j * spacing, 0.6 + layer * spacing},
                                      rotation_about_axis({0.0, 0.0, 1.0}, 0.37 * k));
         weight += w.mass_kg(id) * 9.81;

@@ -173,7 +173,10 @@ TEST_CASE("rebound of a sphere from a free rock against the exact solution, for 
     // own discretisation error at that resolution; what the coupling adds is the difference.
     dem::MaterialTable table = dem::MaterialTable::aitik_copper_ore();
     const double dn = 0.5;
-    table.set_pair("ore", "rock", {0.05, 0.27, 0.85, 0.05, dn, 0.5}, "rebound test");
+    dem::PairCoefficients pair = dem::table2::ore_rock;
+    pair.normal_damping_ratio = dn;
+    pair.tangential_damping_ratio = 0.5;
+    table.set_pair("ore", "rock", pair, "rebound test");
     auto rebound = [&](int n, double density, double& momentum_error) {
         const double v0 = 2.0;
         const double ms = dem::sphere_mass_kg(kSphereRadius, 3700.0), mr = density * 0.027;

@@ -288,7 +288,7 @@ TEST_CASE("coupling bad input: no surface, no coefficients, no substeps", "[coup
         dem::MaterialTable t;
         t.add({"ore", 3700.0, 45e9, 0.3, false});
         t.add({"granite", 2700.0, 45e9, 0.3, false});
-        t.set_pair("ore", "ore", {0.05, 0.27, 0.9, 0.05, 0.9, 0.75});
+        t.set_pair("ore", "ore", dem::table2::ore_ore);
         auto s = make_scene(1, {0, 0, -9.81}, t);
         s->world.add_rock(cube(0.4), 2700.0, s->rigid.material_index("rock"), 1, {0, 0, 1});
         add_sphere(s->dem, {0, 0, 3});

@@ -50,7 +50,7 @@ TEST_CASE("a dense mixed fill places no rock into another, nor a sphere into a r
     auto s = make_scene(5);
     add_container(*s, 3.0, 6.0);
     coupling::MixedDistribution d;
-    d.sphere_mass_fraction = 0.02;
+    d.spheres.mass_fraction = 0.02;
     d.rocks = {{0.30, 0.49}, {0.85, 0.49}};
     std::size_t rocks = 0;
     for (int fill = 0; fill < 2; ++fill) {
@@ -157,7 +157,7 @@ TEST_CASE("mixed bed bad input: fractions, a box too small, corrupt state files"
 {
     auto s = make_scene(1);
     coupling::MixedDistribution bad = coupling::MixedDistribution::thesis_table1();
-    bad.sphere_mass_fraction = 0.5;
+    bad.spheres.mass_fraction = 0.5;
     CHECK_THROWS_WITH(coupling::fill_mixed(s->world, {0, 0, 0}, {2, 2, 2}, bad, table1_materials(*s), 1000.0, 1),
                       Catch::Contains("sum to 1.13") && Catch::Contains("expected 1"));
     // 20 t is 5.4 m3 of solid: refused before any try, as more than even the densest packing puts in 1 m3

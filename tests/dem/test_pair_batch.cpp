@@ -69,7 +69,7 @@ TEST_CASE("the batched pair law gives the scalar law's bits", "[dem][unit]")
         l.wi = vec(c % 6 == 0 ? 30.0 : 0.05);
         l.wj = vec(0.05);
         const double kn = 1e8 * (1.0 + 0.5 * u(rng));
-        l.k = contact_constants(kn, 5.0 + u(rng), l.ri * l.rj / (l.ri + l.rj), PairCoefficients{0.05, 0.27, 0.9, 0.05, 0.9, 0.75});
+        l.k = contact_constants(kn, 5.0 + u(rng), l.ri * l.rj / (l.ri + l.rj), table2::ore_ore);
         if (c % 7 != 0) l.h = {vec(1e-5), vec(c % 3 == 0 ? 1e3 : 1e-2)};  // every third rolling spring beyond its limit
         if (c == 11) l.h.tangential_spring_m = Vec3{0.0, 0.0, 1e-5} + vec(1e-6);  // mostly along the normal
         lanes.push_back(l);

@@ -1,5 +1,6 @@
 // Piles of rocks in Bullet: a pile comes to rest, dipper's narrow phase and solver groups against Bullet's own,
 // the same bits on any number of threads.
+#include "coupling/mixed_bed.h"
 #include "core/errors.h"
 #include "meshes/machine_geometry.h"
 #include "meshes/mesh_builder.h"
@@ -31,7 +32,7 @@ struct PileResult {
 /// 100 steps measured.
 PileResult settle_pile(int count, double settle_s)
 {
-    RigidWorld w = rock_world(0.85);
+    RigidWorld w = rock_world(kTable2RockFriction.rock);
     const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
     PileResult r{0.0, 0.0, 0.0, 0.0};
     for (int k = 0; k < count; ++k) {
@@ -165,14 +166,14 @@ Drop drop_into_box(int threads, bool bullet_pairs)
     RigidSettings s;
     s.threads = threads;
     s.bullet_convex_pairs = bullet_pairs;
-    RigidWorld w = rock_world(s, "ground", 0.85, 0.1, 0.8, 0.1);
+    RigidWorld w = rock_world(s, "ground", kTable2RockFriction.rock, 0.1, 0.8, 0.1);
     const BodyId ground = w.add_ground_plane(0.0, 1, "ground");
     const BodyId box = w.add_static_mesh(meshes::make_open_box_mesh(3.0, 3.0, 2.0, 1.0), 1, "box");
-    const double sizes[4] = {0.3, 0.4, 0.6, 0.85};
+    const std::vector<coupling::RockClass> table1 = coupling::MixedDistribution::thesis_table1().rocks;
     std::vector<BodyId> rocks;
     for (int k = 0; k < 98; ++k) {
         const int i = k % 7, j = (k / 7) % 7, layer = k / 49;
-        const ConvexPolyhedron r = generate_rock({sizes[k % 4], 1.0, 1.8, 16}, 500 + static_cast<std::uint64_t>(k));
+        const ConvexPolyhedron r = generate_rock({table1[k % 4].size_m, 1.0, 1.8, 16}, 500 + static_cast<std::uint64_t>(k));
         rocks.push_back(w.add_rock(r, 2700.0, 0, {0.25 + 0.42 * i, 0.25 + 0.42 * j, 0.5 + 0.9 * layer},
                                    rotation_about_axis(normalized(Vec3{1.0, 0.3 * (k % 3), 0.5}), 0.9 * k)));
     }
@@ -266,10 +267,10 @@ TEST_CASE("the solver's groups move rocks exactly as Bullet's islands do where b
             w.add_rope_shovel(dipper, g, MotionCurves::from_samples({{0.0, hoist, 8.0, 0.0, 0.0}, {10.0, hoist, 8.0, 0.0, 0.0}}, "hold"), 1,
                               {100.0, 100.0, 0.0});
         }
-        const double sizes[4] = {0.3, 0.4, 0.6, 0.85};
+        const std::vector<coupling::RockClass> table1 = coupling::MixedDistribution::thesis_table1().rocks;
         std::vector<BodyId> rocks;
         for (int k = 0; k < 12; ++k)
-            rocks.push_back(w.add_rock(generate_rock({sizes[k % 4], 1.0, 1.8, 16}, 700 + static_cast<std::uint64_t>(k)), 2700.0, 0,
+            rocks.push_back(w.add_rock(generate_rock({table1[k % 4].size_m, 1.0, 1.8, 16}, 700 + static_cast<std::uint64_t>(k)), 2700.0, 0,
                                        {2.5 * (k % 4), 2.5 * (k / 4), 0.6 + 0.05 * k},
                                        rotation_about_axis(normalized(Vec3{1.0, 0.4 * (k % 3), 0.7}), 0.8 * k),
                                        {0.5 * ((k % 3) - 1.0), 0.3, 0.0}, Vec3{2.0, -1.0 + 0.3 * k, 0.5}));

@@ -1,5 +1,6 @@
 // Polyhedral rocks: exact mass properties, hulls and checked meshes, the generator, and rocks in Bullet
 // (static loads, resting height despite the collision margin, per-pair friction, bad input).
+#include "coupling/mixed_bed.h"
 #include "core/errors.h"
 #include "meshes/machine_geometry.h"
 #include "meshes/mesh_builder.h"
@@ -122,7 +123,8 @@ TEST_CASE("rock meshes: convex closed meshes are accepted, non-convex, open or f
 
 TEST_CASE("generated rocks have the size class exactly, their elongation, and repeat with the seed", "[rigid][rocks][unit]")
 {
-    for (const double size : {0.3, 0.4, 0.6, 0.85}) {
+    for (const coupling::RockClass& c : coupling::MixedDistribution::thesis_table1().rocks) {
+        const double size = c.size_m;
         for (std::uint64_t seed = 1; seed <= 20; ++seed) {
             CAPTURE(size, seed);
             const ConvexPolyhedron r = generate_rock({size, 1.2, 2.0, 20}, seed);

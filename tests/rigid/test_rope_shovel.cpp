@@ -24,9 +24,9 @@ RigidWorld shovel_world()
     w.add_material("rock");
     w.add_material("steel");
     w.add_material("ground");
-    w.set_pair("rock", "rock", 0.85, 0.0);
-    w.set_pair("rock", "steel", 0.53, 0.0);
-    w.set_pair("rock", "ground", 0.9, 0.0);
+    w.set_pair("rock", "rock", kTable2RockFriction.rock, 0.0);
+    w.set_pair("rock", "steel", kTable2RockFriction.bucket, 0.0);
+    w.set_pair("rock", "ground", kTable2RockFriction.ground, 0.0);
     w.set_pair("steel", "ground", 0.5, 0.0);
     return w;
 }

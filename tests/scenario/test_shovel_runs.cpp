@@ -160,8 +160,7 @@ output: {vtk_interval_s: 0}
         dem::World* const dem = &scene.dem();
         const FillSpec& f = s.fills[0];
         coupling::MixedDistribution d;
-        d.sphere_radius_m = 0.15;
-        d.sphere_mass_fraction = 0.5;
+        d.spheres = {0.15, 0.5};
         d.rocks = {{0.6, 0.5}};
         const dem::MaterialIndex ore = dem->materials().index_of("ore");
         coupling::fill_mixed(scene.coupled(), f.min_m, f.max_m, d,

@@ -27,13 +27,13 @@ struct RockWearRun {
 /// the bucket's 75 mm surface mesh.
 RockWearRun slide_rocks(double step_s, int iterations, bool slabs)
 {
-    const double mu = 0.53, phi = 1e-12, size = 4.0, height = 0.8, thick = 0.05;
+    const double mu = kTable2RockFriction.bucket, phi = 1e-12, size = 4.0, height = 0.8, thick = 0.05;
     RigidSettings settings;
     settings.solver_iterations = iterations;
     RigidWorld w(settings);
     w.add_material("rock");
     w.add_material("bucket");
-    w.set_pair("rock", "rock", 0.85, 0.0);
+    w.set_pair("rock", "rock", kTable2RockFriction.rock, 0.0);
     w.set_pair("rock", "bucket", mu, 0.0);
     const meshes::TriangleMesh surface = meshes::make_open_box_mesh(size, size, height, 0.075);
     const std::vector<meshes::Plate> plates{
