@@ -106,6 +106,30 @@ inline ContactConstants contact_constants(double kn_N_per_m, double effective_ma
     return k;
 }
 
+/// The coefficients the pair law takes under a form of rolling resistance: all of them for the relative spring;
+/// without rolling friction when it acts on each sphere's own spin instead (RollingResistance::own_spin,
+/// applied where a sphere's torques are summed, World::gather_forces_and_kick).
+inline PairCoefficients law_coefficients(const PairCoefficients& p, RollingResistance form)
+{
+    PairCoefficients c = p;
+    if (form == RollingResistance::own_spin) c.rolling_friction = 0.0;
+    return c;
+}
+
+/// The torque with which a sphere's contacts resist its own spin (RollingResistance::own_spin): of magnitude
+/// `resistance` (the sum of mu_roll r Fn over its contacts, eq. 8) against the spin omega + step_per_inertia
+/// other_torque that the step would otherwise leave it with, and no larger than what brings that spin to rest
+/// (step_per_inertia = dt / I, the step's change of spin per unit torque): it never turns a spin round, so a
+/// sphere at rest stays at rest instead of chattering.
+inline Vec3 spin_resisting_torque(const Vec3& omega, const Vec3& other_torque, double resistance, double step_per_inertia)
+{
+    const Vec3 predicted = omega + other_torque * step_per_inertia;
+    const double spin = norm(predicted);
+    if (!(spin > 0.0) || !(resistance > 0.0)) return {};
+    const double magnitude = std::min(resistance, spin / step_per_inertia);
+    return predicted * (-magnitude / spin);
+}
+
 /// The linear spring-dashpot law with Coulomb friction and rolling resistance.
 ///
 /// Normal (eq. 3, 6): Fn = max(0, Kn delta - c_n v_n), c_n = D_n 2 sqrt(m* Kn). The clamp at zero means

@@ -83,6 +83,7 @@ void ConvexPairs::build(const std::vector<std::uint32_t>& candidate_start, const
     constants_.assign(pairs_.size(), ContactConstants{});
     touching_.assign(pairs_.size(), 0);
     push_.assign(pairs_.size(), Push{});
+    spin_N_m_.assign(pairs_.size(), 0.0);
     pair_start_.assign(n + 1, 0);
     for (const Pair& p : pairs_) ++pair_start_[p.particle + 1];
     std::partial_sum(pair_start_.begin(), pair_start_.end(), pair_start_.begin());
@@ -254,6 +255,7 @@ std::size_t ConvexPairs::compute(std::size_t begin, std::size_t end, const Parti
             if (touching_[k]) {  // separated: the history of this contact ends
                 touching_[k] = 0;
                 push_[k] = Push{};
+                spin_N_m_[k] = 0.0;
             }
             continue;
         }
@@ -277,13 +279,15 @@ std::size_t ConvexPairs::compute(std::size_t begin, std::size_t end, const Parti
         ContactConstants& constants = constants_[k];
         if (constants.normal_stiffness_N_per_m == 0.0)
             constants = contact_constants(wall_normal_stiffness(bulk_modulus_Pa[mat], r, p.normal_stiffness_scale),
-                                          motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r, p);
+                                          motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r,
+                                          law_coefficients(p, materials.rolling_resistance()));
         const Vec3 relative_velocity = v + cross(w, c.point - x) - motion.velocity_at(c.point);
         c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - motion.angular_velocity_rad_per_s, constants,
                                          c.history, dt_s);
         c.relative_displacement_m = relative_velocity * dt_s;
         const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
         push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
+        spin_N_m_[k] = materials.rolling_resistance() == RollingResistance::own_spin ? p.rolling_friction * r * c.forces.normal_force_N : 0.0;
         // the body's reaction, while the contact is in cache
         const Vec3 on_wall = -force;
         body_force[frame.wall] += on_wall;

@@ -53,6 +53,11 @@ public:
             torque += p.torque_N_m;
         }
     }
+    /// Under RollingResistance::own_spin: adds the sum of mu_roll r Fn of particle i's pairs to spin_resistance.
+    void push_spin_resistance(std::size_t i, double& spin_resistance) const
+    {
+        for (std::uint32_t k = pair_start_[i]; k < pair_start_[i + 1]; ++k) spin_resistance += spin_N_m_[pair_index_[k]];
+    }
 
     std::size_t size() const { return pairs_.size(); }
     bool touching(std::size_t k) const { return touching_[k] != 0; }
@@ -88,6 +93,7 @@ private:
     std::vector<WallContact> contacts_;       ///< beside pairs_: the contact of this step, if touching
     std::vector<std::uint8_t> touching_;      ///< beside pairs_
     std::vector<Push> push_;                  ///< beside pairs_ (zero when apart)
+    std::vector<double> spin_N_m_;            ///< beside pairs_: under own_spin mu_roll r Fn (zero when apart)
     std::vector<std::uint32_t> pair_start_, pair_index_;  ///< each particle's pairs
     std::vector<std::size_t> pass_start_;     ///< the pairs whose contacts each thread computes: shares of equal cost
 };

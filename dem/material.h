@@ -50,6 +50,18 @@ inline constexpr PairCoefficients ore_truck{0.05, 0.27, 0.85, 0.05, 1.0, 1.0};
 inline constexpr PairCoefficients ore_steel{0.05, 0.27, 0.0, 0.0, 1.0, 1.0};
 }  // namespace table2
 
+/// How rolling resistance (thesis eq. 8) acts.
+enum class RollingResistance {
+    /// An elastic-plastic spring on the pair's relative rolling rotation, |Mr| <= mu_roll R* Fn with R* the
+    /// pair's effective radius (Ai, Chen, Rotter & Ooi 2011, type C): a pile at rest stays at rest. The default.
+    relative_spring,
+    /// Each contact resists the sphere's own spin with a torque mu_roll r Fn, r the sphere's own radius (eq. 8
+    /// as the thesis writes it, "a moment for the particle"; the constant-torque rolling friction of Zhou et
+    /// al. 1999 that EDEM applies by default). The contacts' torques on a sphere, summed, slow its spin over a
+    /// step at most to rest, never past it; walls and bodies feel no reaction to them.
+    own_spin,
+};
+
 /// The constant material model of a run: materials and a symmetric table of pair coefficients. Built
 /// and validated once; read-only (and so thread-safe) during the run.
 class MaterialTable {
@@ -83,12 +95,17 @@ public:
     /// to hit the bulk density 1903 kg/m3; coupling/bulk_density.h finds the scaled value).
     static MaterialTable aitik_copper_ore(double particle_density_kg_per_m3 = 3700.0);
 
+    /// The form of rolling resistance of every pair (RollingResistance::relative_spring unless set).
+    RollingResistance rolling_resistance() const { return rolling_resistance_; }
+    void set_rolling_resistance(RollingResistance form) { rolling_resistance_ = form; }
+
 private:
     void check_index(MaterialIndex i, const std::string& where) const;
 
     std::vector<Material> materials_;
     std::vector<PairCoefficients> pairs_;
     std::vector<bool> defined_;
+    RollingResistance rolling_resistance_ = RollingResistance::relative_spring;
 };
 
 /// Throws InputError naming the key and value if a coefficient is outside its range.

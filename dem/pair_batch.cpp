@@ -45,6 +45,7 @@ double evaluate_pair_batch(PairBatch& b, double dt_s)
         const Vec3 ti = f.rolling_torque_N_m - n_x_ft * a_i;
         const Vec3 tj = -(f.rolling_torque_N_m + n_x_ft * a_j);
         b.fx[c] = force.x; b.fy[c] = force.y; b.fz[c] = force.z;
+        b.fn[c] = f.normal_force_N;
         b.tix[c] = ti.x; b.tiy[c] = ti.y; b.tiz[c] = ti.z;
         b.tjx[c] = tj.x; b.tjy[c] = tj.y; b.tjz[c] = tj.z;
     }

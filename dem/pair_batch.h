@@ -28,8 +28,8 @@ struct PairBatch {
         friction[kCapacity];
     // history: tangential spring and rolling torque
     alignas(64) double sx[kCapacity], sy[kCapacity], sz[kCapacity], mx[kCapacity], my[kCapacity], mz[kCapacity];
-    // outputs: force on i (j gets the opposite), torques on i and on j
-    alignas(64) double fx[kCapacity], fy[kCapacity], fz[kCapacity];
+    // outputs: force on i (j gets the opposite), its normal part, torques on i and on j
+    alignas(64) double fx[kCapacity], fy[kCapacity], fz[kCapacity], fn[kCapacity];
     alignas(64) double tix[kCapacity], tiy[kCapacity], tiz[kCapacity], tjx[kCapacity], tjy[kCapacity], tjz[kCapacity];
 
     /// Appends the constants of one lane.

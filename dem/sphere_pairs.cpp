@@ -163,9 +163,12 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
     std::uint8_t* __restrict touching = touching_.data();
     ContactHistory* __restrict history = history_.data();
     const MaterialTable& table = materials;
+    const RollingResistance rolling = table.rolling_resistance();
+    const bool own_spin = rolling == RollingResistance::own_spin;
     double max_ratio = 0.0;
     thread_force_N_.resize(static_cast<std::size_t>(threads));
     thread_torque_N_m_.resize(static_cast<std::size_t>(threads));
+    thread_spin_N_m_.resize(own_spin ? static_cast<std::size_t>(threads) : 0);
     const bool ranges_stale = touched_ranges_version_ != version_ || thread_touched_.size() != static_cast<std::size_t>(threads);
     if (thread_touched_.size() != static_cast<std::size_t>(threads)) forces_clear_ = false;
     thread_touched_.resize(static_cast<std::size_t>(threads));
@@ -195,6 +198,13 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
         if (thread_torque.size() != n) thread_torque.resize(n);
         Vec3* __restrict force = thread_force.data();
         Vec3* __restrict torque = thread_torque.data();
+        double* __restrict spin = nullptr;
+        if (own_spin) {
+            auto& thread_spin = thread_spin_N_m_[static_cast<std::size_t>(t)];
+            if (thread_spin.size() != n) thread_spin.assign(n, 0.0);
+            if (!forces_clear_) std::fill(thread_spin.begin(), thread_spin.end(), 0.0);
+            spin = thread_spin.data();
+        }
         // the gather leaves every element it reads at zero; only after an interrupted step are they cleared here
         if (!forces_clear_) {
             std::fill(thread_force.begin(), thread_force.end(), Vec3{});
@@ -202,6 +212,8 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
         }
         double local_max = 0.0;
         PairBatch batch;  // the touching pairs, gathered for the SIMD law and scattered after it
+        double spin_lever_i[PairBatch::kCapacity], spin_lever_j[PairBatch::kCapacity];  // own_spin: mu_roll r_i, mu_roll r_j
+        double memo_spin_i = 0.0, memo_spin_j = 0.0;
 
         // forces of the gathered pairs into the thread's arrays, springs back into the pair history
         auto flush = [&]() {
@@ -213,6 +225,10 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
                 force[j] -= fi;
                 torque[i] += Vec3{batch.tix[c], batch.tiy[c], batch.tiz[c]};
                 torque[j] += Vec3{batch.tjx[c], batch.tjy[c], batch.tjz[c]};
+                if (own_spin) {
+                    spin[i] += spin_lever_i[c] * batch.fn[c];
+                    spin[j] += spin_lever_j[c] * batch.fn[c];
+                }
                 history[batch.pair[c]] = {{batch.sx[c], batch.sy[c], batch.sz[c]}, {batch.mx[c], batch.my[c], batch.mz[c]}};
             }
             batch.count = 0;
@@ -244,7 +260,9 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
                 const double kr_sum = kr[i] + kr[j], m_sum = m[i] + m[j];
                 const PairCoefficients& coefficients = table.pair_unchecked(mat[i], mat[j]);
                 memo = contact_constants(kr[i] * kr[j] / kr_sum * coefficients.normal_stiffness_scale, m[i] * m[j] / m_sum,
-                                         r[i] * r[j] / rsum, coefficients);
+                                         r[i] * r[j] / rsum, law_coefficients(coefficients, rolling));
+                memo_spin_i = coefficients.rolling_friction * r[i];
+                memo_spin_j = coefficients.rolling_friction * r[j];
                 // The two springs k1 r1 and k2 r2 in series share the overlap in proportion to their
                 // compliances: the contact point lies half-way for equal spheres and on the surface of a much
                 // stiffer body (the wall limit).
@@ -264,6 +282,8 @@ double SpherePairs::compute_forces(const ParticleStore& p, const std::vector<dou
             batch.wix[c] = w[i].x; batch.wiy[c] = w[i].y; batch.wiz[c] = w[i].z;
             batch.wjx[c] = w[j].x; batch.wjy[c] = w[j].y; batch.wjz[c] = w[j].z;
             batch.set_constants(c, memo);
+            spin_lever_i[c] = memo_spin_i;
+            spin_lever_j[c] = memo_spin_j;
             const ContactHistory& h = history[k];
             batch.sx[c] = h.tangential_spring_m.x; batch.sy[c] = h.tangential_spring_m.y; batch.sz[c] = h.tangential_spring_m.z;
             batch.mx[c] = h.rolling_torque_N_m.x; batch.my[c] = h.rolling_torque_N_m.y; batch.mz[c] = h.rolling_torque_N_m.z;

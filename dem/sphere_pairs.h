@@ -72,6 +72,16 @@ public:
             thread_torque_N_m_[t][i] = Vec3{};
         }
     }
+    /// Under RollingResistance::own_spin: adds the pairs' sum of mu_roll r_i Fn on particle i (the torque
+    /// that resists its spin) to `spin_resistance`, in thread order, and clears it. Before take(i, ...).
+    void take_spin_resistance(std::size_t i, double& spin_resistance)
+    {
+        for (std::size_t t = 0; t < thread_spin_N_m_.size(); ++t) {
+            if (i < thread_touched_[t].begin || i >= thread_touched_[t].end) continue;
+            spin_resistance += thread_spin_N_m_[t][i];
+            thread_spin_N_m_[t][i] = 0.0;
+        }
+    }
     void gathered() { forces_clear_ = true; }
 
     std::size_t size() const { return pair_i_.size(); }
@@ -93,6 +103,7 @@ private:
     std::vector<std::uint8_t> touching_;
     // forces and torques each thread's pairs add up, per particle; the gather adds them in thread order
     std::vector<std::vector<Vec3>> thread_force_N_, thread_torque_N_m_;
+    std::vector<std::vector<double>> thread_spin_N_m_;  ///< under own_spin: sum of mu_roll r Fn, per particle
     /// The particles each thread's block of pairs touches: its force arrays hold sums there, and nothing elsewhere.
     struct ParticleRange { std::uint32_t begin = 0, end = 0; };
     std::vector<ParticleRange> thread_touched_;

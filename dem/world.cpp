@@ -550,7 +550,7 @@ void World::apply_wall_law(WallContact& c, const Vec3& x, const Vec3& v, const V
     s.effective_mass_kg = wall.mass_kg > 0.0 ? particles_.mass_kg[i] * wall.mass_kg / (particles_.mass_kg[i] + wall.mass_kg)
                                              : particles_.mass_kg[i];
     s.normal_stiffness_N_per_m = wall_normal_stiffness(bulk_modulus_Pa_[particles_.material[i]], r, p.normal_stiffness_scale);
-    c.forces = linear_spring_dashpot(s, p, c.history, dt_s);
+    c.forces = linear_spring_dashpot(s, law_coefficients(p, materials_.rolling_resistance()), c.history, dt_s);
     c.relative_displacement_m = s.relative_velocity_m_per_s * dt_s;
 }
 
@@ -706,12 +706,15 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
     auto& v = particles_.velocity_m_per_s;
     auto& w = particles_.angular_velocity_rad_per_s;
     const std::uint8_t* frozen = particles_.frozen.data();
+    const bool own_spin = materials_.rolling_resistance() == RollingResistance::own_spin;
     double max_move2 = 0.0;
     int bad = -1;
 #pragma omp parallel for schedule(static) num_threads(threads_) reduction(max : bad, max_move2)
     for (std::size_t i = 0; i < n; ++i) {
         Vec3 f = g * particles_.mass_kg[i];
         Vec3 torque{};
+        double spin_resistance = 0.0;  // own_spin: the sum of mu_roll r Fn over the contacts
+        if (own_spin) pairs_.take_spin_resistance(i, spin_resistance);
         pairs_.take(i, f, torque);
         if (frozen[i]) continue;  // at rest where it is (its share of the pairs' sums is cleared all the same)
         for (std::uint32_t k = wall_contact_start_[i]; k < wall_contact_start_[i + 1]; ++k) {
@@ -719,8 +722,16 @@ double World::gather_forces_and_kick(double half_kick_s, bool next_drift)
             const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
             f += force;
             torque += cross(c.point - x[i], force) + c.forces.rolling_torque_N_m;
+            if (own_spin)
+                spin_resistance += materials_.pair_unchecked(particles_.material[i], wall_motion_[static_cast<std::size_t>(c.wall)].material)
+                                       .rolling_friction *
+                                   particles_.radius_m[i] * c.forces.normal_force_N;
         }
         convex_.push(i, f, torque);
+        if (own_spin) {
+            convex_.push_spin_resistance(i, spin_resistance);
+            torque += spin_resisting_torque(w[i], torque, spin_resistance, dt * particles_.inverse_inertia_per_kg_m2[i]);
+        }
         if (!next_drift) {  // within a run of steps the force is used here and nowhere else
             particles_.force_N[i] = f;
             particles_.torque_N_m[i] = torque;

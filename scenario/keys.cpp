@@ -24,6 +24,10 @@ const std::vector<KeySpec>& scenario_keys()
          "starting table: aitik_copper_ore (materials ore, rock, ground, bucket, truck, steel and their pairs) or none"},
         {"materials.particle_density_kg_per_m3", "number", "3700",
          "density of the preset's ore and rock (the bulk-density calibration scales it)"},
+        {"materials.rolling_resistance", "string", "relative_spring",
+         "how rolling friction (eq. 8) acts: relative_spring (an elastic-plastic spring on a pair's relative rolling, "
+         "limit mu_roll R* Fn) or own_spin (each contact resists the sphere's own spin with mu_roll r Fn, r its "
+         "radius); docs/contact_model.md"},
         {"materials.add", "list", "[]", "materials added to the preset"},
         {"materials.add[].name", "string", "required", "unique material name"},
         {"materials.add[].surface", "boolean", "false", "true for a wall material (infinitely stiff and massive)"},

@@ -76,6 +76,10 @@ void read_materials(const MapReader& top, Scenario& s)
     if (preset == "aitik_copper_ore") s.materials = dem::MaterialTable::aitik_copper_ore(density);
     else if (preset == "none") s.materials = dem::MaterialTable{};
     else m.fail("preset", concat("\"", preset, "\""), "aitik_copper_ore or none");
+    const std::string rolling = m.text("rolling_resistance");
+    if (rolling == "relative_spring") s.materials.set_rolling_resistance(dem::RollingResistance::relative_spring);
+    else if (rolling == "own_spin") s.materials.set_rolling_resistance(dem::RollingResistance::own_spin);
+    else m.fail("rolling_resistance", concat("\"", rolling, "\""), "relative_spring or own_spin");
 
     for (const MapReader& a : m.maps("add")) {
         dem::Material mat;

@@ -219,6 +219,38 @@ TEST_CASE("a sphere dropped on a fixed rock rebounds as on a fixed mesh copy of 
     CHECK(norm(xa - xb) < 1e-12);
 }
 
+TEST_CASE("resisting its own spin, a sphere rolling over a fixed rock moves as over a fixed mesh copy of it", "[coupling][unit]")
+{
+    // Under own_spin the sphere-rock pairs sum their rolling resistance in the rock pairs, the mesh walls in the
+    // wall contacts: the same law by two paths. The sphere lands spinning and sliding on the rock's top, rolls
+    // over it and falls off its side.
+    dem::MaterialTable table = dem::MaterialTable::aitik_copper_ore();
+    table.set_rolling_resistance(dem::RollingResistance::own_spin);
+    const rigid::ConvexPolyhedron rock = test_rock(0.6, 23);
+    const Vec3 start{0.03, -0.02, rock.support_m({0, 0, 1}) + 0.15};
+    const Vec3 velocity{0.8, 0.3, 0.0}, spin{-3.0, 9.0, 1.0};
+    auto a = make_scene(1, {0.0, 0.0, -9.81}, table);
+    const rigid::BodyId fixed = a->rigid.add_static_mesh(rock.to_mesh(), a->rigid.material_index("rock"), "fixed rock");
+    a->world.couple(fixed, rock.to_mesh(), a->dem.materials().index_of("rock"), "fixed_rock");
+    a->dem.add_particle({start, velocity, spin, kSphereRadius, a->dem.materials().index_of("ore")});
+    dem::World b(table, dem::WorldSettings{});
+    b.add_mesh(rock.to_mesh(), b.materials().index_of("rock"), "mesh_rock");
+    b.add_particle({start, velocity, spin, kSphereRadius, b.materials().index_of("ore")});
+    double contact_s = 0.0;
+    while (a->dem.time_s() < 0.4) {
+        a->world.step();
+        b.step();
+        if (norm(a->dem.wall_force_N(0)) > 0.0) contact_s += a->dem.step_s();
+    }
+    REQUIRE(contact_s > 0.05);  // it rolled on the rock for a while
+    const auto& pa = a->dem.particles();
+    const auto& pb = b.particles();
+    // the same operations in the same order: identical to round-off
+    CHECK(norm(pa.velocity_m_per_s[0] - pb.velocity_m_per_s[0]) < 1e-12);
+    CHECK(norm(pa.angular_velocity_rad_per_s[0] - pb.angular_velocity_rad_per_s[0]) < 1e-10);
+    CHECK(norm(pa.position_m[0] - pb.position_m[0]) < 1e-12);
+}
+
 TEST_CASE("a colliding cloud of spheres and rocks keeps its momentum", "[coupling][analytic]")
 {
     // No gravity: spheres and rocks converge on a point, collide with each other (sphere-sphere, sphere-rock in

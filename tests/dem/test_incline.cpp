@@ -17,11 +17,13 @@ struct InclineResult {
 
 /// The incline is the floor z = 0 with gravity tilted by theta about y; the sphere starts resting at
 /// its static overlap, so the normal force needs no settling.
-InclineResult run_incline(double theta_rad, double friction, double rolling)
+InclineResult run_incline(double theta_rad, double friction, double rolling,
+                          RollingResistance form = RollingResistance::relative_spring)
 {
     const double r = 0.1, g = 9.81;
     const PairCoefficients p = test::coefficients(friction, rolling, 1.0, 1.0, 0.05, 0.27);
-    const MaterialTable table = test::two_material_table(p, 3700.0, 45e9, 0.3);
+    MaterialTable table = test::two_material_table(p, 3700.0, 45e9, 0.3);
+    table.set_rolling_resistance(form);
     WorldSettings s;
     s.gravity_m_per_s2 = {g * std::sin(theta_rad), 0.0, -g * std::cos(theta_rad)};
     World w(table, s);
@@ -82,4 +84,18 @@ TEST_CASE("sphere on an incline slides with a = g (sin - mu cos) above tan(theta
     const InclineResult got = run_incline(theta, 0.1, 0.05);
     CHECK(got.acceleration_m_per_s2 == Approx(9.81 * (std::sin(theta) - 0.1 * std::cos(theta))).epsilon(5e-3));
     CHECK(got.slip_m_per_s > 0.5);
+}
+
+TEST_CASE("resisting its own spin, a sphere on an incline rests while tan(theta) <= mu_roll and rolls as with the spring above",
+          "[dem][analytic]")
+{
+    // On a fixed surface the sphere's own spin is its rolling on the surface, and the wall's lever R* is r: the
+    // two forms give one law. The same bounds as the spring's cases above.
+    const InclineResult rest = run_incline(std::atan(0.2), 0.9, 0.3, RollingResistance::own_spin);
+    CHECK(std::abs(rest.displacement_m) < 1e-6);
+    CHECK(std::abs(rest.acceleration_m_per_s2) < 1e-5);
+    const double theta = 20.0 * M_PI / 180.0;
+    const InclineResult rolls = run_incline(theta, 0.5, 0.05, RollingResistance::own_spin);
+    CHECK(rolls.acceleration_m_per_s2 == Approx(5.0 / 7.0 * 9.81 * (std::sin(theta) - 0.05 * std::cos(theta))).epsilon(5e-3));
+    CHECK(std::abs(rolls.slip_m_per_s) < 1e-3);
 }

@@ -188,6 +188,10 @@ TEST_CASE("every class of scenario error names file, line, column, key, value an
     // pair coefficients for a material that does not exist
     e = error_of(small_scenario() + "materials:\n  pairs:\n    - {materials: [ore, granite], friction: 0.5}\n");
     CHECK_THAT(e, Catch::Contains("materials.pairs[0].materials") && Catch::Contains("granite"));
+
+    // a form of rolling resistance that dipper does not have
+    e = error_of(small_scenario() + "materials:\n  rolling_resistance: constant\n");
+    CHECK_THAT(e, Catch::Contains("materials.rolling_resistance: got \"constant\"; expected relative_spring or own_spin"));
 }
 
 TEST_CASE("a mesh file that cannot be read names the scenario entry", "[scenario]")
