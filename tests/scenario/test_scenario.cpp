@@ -317,6 +317,26 @@ TEST_CASE("a run stopped at a checkpoint and resumed ends bit for bit as the uni
     fs::remove_all(base);
 }
 
+TEST_CASE("resisting each sphere's own spin, a run resumed from a checkpoint ends bit for bit", "[scenario]")
+{
+    // the spin resistance is summed anew at each step from the contacts; the torque it adds is in the checkpoint
+    const fs::path base = fs::temp_directory_path() / "dipper_test_resume_own_spin";
+    fs::remove_all(base);
+    const Scenario s = parse_scenario(small_scenario("materials: {rolling_resistance: own_spin}\n"), "small.yaml", ".");
+    const RunResult whole = run_scenario(s, (base / "whole").string(), quiet());
+    REQUIRE(whole.status == RunStatus::completed);
+    RunOptions stop = quiet();
+    stop.stop_after_s = 0.137;
+    REQUIRE(run_scenario(s, (base / "parts").string(), stop).status == RunStatus::interrupted);
+    REQUIRE(resume_run((base / "parts").string(), quiet()).status == RunStatus::completed);
+    CHECK(summary_value((base / "parts").string(), "state_hash") == summary_value((base / "whole").string(), "state_hash"));
+    // and the form changes the run: the same scenario with the relative spring ends elsewhere
+    const RunResult spring = run_scenario(parse_scenario(small_scenario(), "small.yaml", "."), (base / "spring").string(), quiet());
+    REQUIRE(spring.status == RunStatus::completed);
+    CHECK(summary_value((base / "spring").string(), "state_hash") != summary_value((base / "whole").string(), "state_hash"));
+    fs::remove_all(base);
+}
+
 TEST_CASE("a truncated or corrupt checkpoint is refused and the previous one is named", "[scenario]")
 {
     const fs::path base = fs::temp_directory_path() / "dipper_test_corrupt";
