@@ -155,6 +155,7 @@ std::size_t ConvexPairs::compute(std::size_t begin, std::size_t end, const Parti
                                  const MaterialTable& materials, const std::vector<double>& bulk_modulus_Pa, double max_overlap_ratio,
                                  double dt_s, std::size_t& first_deep, Vec3* __restrict body_force, Vec3* __restrict body_torque)
 {
+    const RollingResistance rolling = materials.rolling_resistance();
     // A convex body (a rock's hull) lies behind each of its face planes. A centre a radius or more in front of one
     // of the faces within reach touches none of them. A centre in front of some face lies outside, and the hull's
     // closest point then lies on a face it is in front of (the direction to it is in the normal cone there); a
@@ -280,14 +281,14 @@ std::size_t ConvexPairs::compute(std::size_t begin, std::size_t end, const Parti
         if (constants.normal_stiffness_N_per_m == 0.0)
             constants = contact_constants(wall_normal_stiffness(bulk_modulus_Pa[mat], r, p.normal_stiffness_scale),
                                           motion.mass_kg > 0.0 ? m * motion.mass_kg / (m + motion.mass_kg) : m, r,
-                                          law_coefficients(p, materials.rolling_resistance()));
+                                          law_coefficients(p, rolling));
         const Vec3 relative_velocity = v + cross(w, c.point - x) - motion.velocity_at(c.point);
         c.forces = linear_spring_dashpot(c.overlap_m, c.normal, relative_velocity, w - motion.angular_velocity_rad_per_s, constants,
                                          c.history, dt_s);
         c.relative_displacement_m = relative_velocity * dt_s;
         const Vec3 force = c.normal * c.forces.normal_force_N + c.forces.tangential_force_N;
         push_[k] = {force, cross(c.point - x, force) + c.forces.rolling_torque_N_m};
-        spin_N_m_[k] = materials.rolling_resistance() == RollingResistance::own_spin ? p.rolling_friction * r * c.forces.normal_force_N : 0.0;
+        if (rolling == RollingResistance::own_spin) spin_N_m_[k] = p.rolling_friction * r * c.forces.normal_force_N;
         // the body's reaction, while the contact is in cache
         const Vec3 on_wall = -force;
         body_force[frame.wall] += on_wall;

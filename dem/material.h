@@ -57,7 +57,7 @@ enum class RollingResistance {
     relative_spring,
     /// Each contact resists the sphere's own spin with a torque mu_roll r Fn, r the sphere's own radius (eq. 8
     /// as the thesis writes it, "a moment for the particle"; the constant-torque rolling friction of Zhou et
-    /// al. 1999 that EDEM applies by default). The contacts' torques on a sphere, summed, slow its spin over a
+    /// al. 1999, which EDEM calls its standard rolling friction). The contacts' torques on a sphere, summed, slow its spin over a
     /// step at most to rest, never past it; walls and bodies feel no reaction to them.
     own_spin,
 };
