@@ -35,6 +35,13 @@ void for_each_body(std::size_t n, int threads, F&& f)
     if (first) std::rethrow_exception(first);
 }
 
+/// The rotation by a rotation vector (axis times angle).
+Mat3 rotation_of(const Vec3& turn_rad)
+{
+    const double angle = norm(turn_rad);
+    return angle > 0.0 ? rotation_about_axis(turn_rad * (1.0 / angle), angle) : Mat3::identity();
+}
+
 }  // namespace
 
 Vec3 rotation_vector(const Mat3& r)
@@ -96,6 +103,7 @@ int CoupledWorld::couple(rigid::BodyId body, meshes::TriangleMesh surface, dem::
     spin_rad_.push_back({});
     force_sum_.push_back({});
     torque_sum_.push_back({});
+    response_.push_back({});
     Watch w;
     w.velocity_m_per_s = s.velocity_m_per_s;
     w.angular_velocity_rad_per_s = s.angular_velocity_rad_per_s;
@@ -206,7 +214,8 @@ void CoupledWorld::write_state(StateWriter& out) const { state_fields(out, *this
 void CoupledWorld::read_state(StateReader& in)
 {
     state_fields(in, *this);
-    for (std::size_t size : {before_.size(), after_.size(), spin_rad_.size(), force_sum_.size(), torque_sum_.size(), watch_.size()})
+    for (std::size_t size : {before_.size(), after_.size(), spin_rad_.size(), force_sum_.size(), torque_sum_.size(), watch_.size(),
+                             response_.size()})
         if (size != bodies_.size()) in.fail("coupling or runaway-guard arrays of another number of bodies");
     checked_bodies_ = 0;  // checked again before the next step
 }
@@ -281,21 +290,33 @@ void CoupledWorld::move_surfaces(double fraction, double interval_s)
         const Pose& a = before_[k];
         const Pose& b = after_[k];
         const Vec3 spin = spin_rad_[k];
-        if (spin == Vec3{} && a.centre_m == b.centre_m && a.origin_m == b.origin_m) {
-            // a fixed part or a frozen rock: place it once, at rest, and leave it (no vertex work, no neighbour-list
-            // churn)
+        RockResponse& r = response_[k];
+        const bool responding = r.velocity_m_per_s != Vec3{} || r.angular_velocity_rad_per_s != Vec3{} ||
+                                r.displacement_m != Vec3{} || r.turn_rad != Vec3{};
+        if (spin == Vec3{} && a.centre_m == b.centre_m && a.origin_m == b.origin_m && !responding) {
+            // a fixed part, a frozen rock or one at rest: place it once, at rest, and leave it (no vertex work, no
+            // neighbour-list churn)
             const dem::MeshWall& wall = dem_.mesh_wall(bodies_[k].wall);
             if (wall.velocity_at(wall.reference_point_m()) == Vec3{} && wall.angular_velocity_rad_per_s() == Vec3{} &&
                 wall.translation_m() == b.origin_m)
                 return;
         }
         const double angle = norm(spin);
-        const Mat3 turn = angle > 0.0 ? rotation_about_axis(spin * (1.0 / angle), angle * fraction) : Mat3::identity();
-        const Mat3 rotation = turn * a.rotation;
-        const Vec3 centre = a.centre_m + (b.centre_m - a.centre_m) * fraction;
-        const Vec3 origin = centre + turn * (a.origin_m - a.centre_m);
-        dem_.set_mesh_pose(bodies_[k].wall, rotation, origin, centre, (b.centre_m - a.centre_m) * (1.0 / interval_s),
-                           spin * (1.0 / interval_s));
+        Mat3 turn = angle > 0.0 ? rotation_about_axis(spin * (1.0 / angle), angle * fraction) : Mat3::identity();
+        Vec3 centre = a.centre_m + (b.centre_m - a.centre_m) * fraction;
+        Vec3 velocity = (b.centre_m - a.centre_m) * (1.0 / interval_s), angular_velocity = spin * (1.0 / interval_s);
+        if (responding) {
+            // the spheres' own motion of the rock since Bullet's step, drifted over this sub-step, on top
+            const double dt = dem_.step_s();
+            r.displacement_m += r.velocity_m_per_s * dt;
+            r.turn_rad += r.angular_velocity_rad_per_s * dt;
+            turn = rotation_of(r.turn_rad) * turn;
+            centre += r.displacement_m;
+            velocity += r.velocity_m_per_s;
+            angular_velocity += r.angular_velocity_rad_per_s;
+        }
+        dem_.set_mesh_pose(bodies_[k].wall, turn * a.rotation, centre + turn * (a.origin_m - a.centre_m), centre, velocity,
+                           angular_velocity);
     });
 }
 
@@ -362,7 +383,7 @@ double CoupledWorld::send_reactions(int steps)
         CoupledBody& b = bodies_[k];
         b.applied_force_N = force_sum_[k] * scale;
         b.applied_torque_N_m = torque_sum_[k] * scale;
-        if (b.dynamic) rigid_.apply_force_and_torque(b.body, b.applied_force_N, b.applied_torque_N_m);
+        if (b.dynamic && !responds_at_dem_rate(k)) rigid_.apply_force_and_torque(b.body, b.applied_force_N, b.applied_torque_N_m);
         before_[k] = pose_of(b);
         force_sum_[k] = Vec3{};
         torque_sum_[k] = Vec3{};
@@ -385,6 +406,7 @@ void CoupledWorld::run_dem(int steps, double interval_s)
         after_[k] = pose_of(bodies_[k]);
         spin_rad_[k] = rotation_vector(after_[k].rotation * before_[k].rotation.transposed());
     });
+    if (settings_.rock_exchange == RockExchange::dem_step) start_responses();
     // the DEM sub-steps, the surfaces moving from the old poses to the new ones, the reactions summed
     dem::World::StepHooks hooks;
     hooks.before_forces = [&](std::uint64_t s) {
@@ -400,10 +422,56 @@ void CoupledWorld::run_dem(int steps, double interval_s)
             const auto w = static_cast<std::size_t>(bodies_[k].wall);
             force_sum_[k] += force[w];
             torque_sum_[k] += torque[w];
+            RockResponse& r = response_[k];
+            if (r.inverse_mass > 0.0) {  // the rock takes the sub-step's impulse at once (semi-implicit Euler)
+                const double dt = dem_.step_s();
+                r.velocity_m_per_s += force[w] * (r.inverse_mass * dt);
+                r.angular_velocity_rad_per_s += r.inverse_inertia * (torque[w] * dt);
+            }
         }
         ++samples_;
     };
     dem_.run_steps(static_cast<std::uint64_t>(steps), hooks);
+    if (settings_.rock_exchange == RockExchange::dem_step) hand_responses_to_rigid();
+}
+
+bool CoupledWorld::responds_at_dem_rate(std::size_t k) const
+{
+    // rocks are the coupled bodies with a radius of gyration (add_rock)
+    return settings_.rock_exchange == RockExchange::dem_step && watch_[k].radius_of_gyration_m != Vec3{};
+}
+
+void CoupledWorld::start_responses()
+{
+    for_each_body(bodies_.size(), dem_.threads(), [&](std::size_t k) {
+        RockResponse& r = response_[k];
+        r = RockResponse{};
+        if (!responds_at_dem_rate(k) || rigid_.frozen(bodies_[k].body)) return;  // a frozen rock is held: no response
+        const double mass = rigid_.mass_kg(bodies_[k].body);
+        const Vec3 g = watch_[k].radius_of_gyration_m;  // principal moments m g^2
+        Mat3 inverse_principal;
+        inverse_principal.m[0][0] = 1.0 / (mass * g.x * g.x);
+        inverse_principal.m[1][1] = 1.0 / (mass * g.y * g.y);
+        inverse_principal.m[2][2] = 1.0 / (mass * g.z * g.z);
+        const Mat3& rotation = after_[k].rotation;  // a rock's part frame is its principal frame
+        r.inverse_inertia = rotation * inverse_principal * rotation.transposed();
+        r.inverse_mass = 1.0 / mass;
+    });
+}
+
+void CoupledWorld::hand_responses_to_rigid()
+{
+    for_each_body(bodies_.size(), dem_.threads(), [&](std::size_t k) {
+        RockResponse& r = response_[k];
+        if (r.inverse_mass == 0.0) return;
+        rigid::BodyState s = rigid_.state(bodies_[k].body);
+        s.position_m += r.displacement_m;
+        s.rotation = rotation_of(r.turn_rad) * s.rotation;
+        s.velocity_m_per_s += r.velocity_m_per_s;
+        s.angular_velocity_rad_per_s += r.angular_velocity_rad_per_s;
+        rigid_.set_rock_motion(bodies_[k].body, s);
+        r = RockResponse{};
+    });
 }
 
 void CoupledWorld::end_step()

@@ -35,6 +35,20 @@ inline constexpr double kRunawayGrowth = 8.0;
 inline constexpr double kRunawayFloor_m_per_s = 0.1;
 inline constexpr int kRunawayHoldSteps = 50;
 
+/// How the rocks (bodies made with CoupledWorld::add_rock) take the spheres' forces (docs/coupling.md).
+enum class RockExchange {
+    /// Bullet's step gives each rock the mean reaction of the last exchange's sub-steps: the rock answers the
+    /// spheres one coupling step late (the step described at CoupledWorld).
+    coupling_step,
+    /// Each DEM sub-step's reaction turns the rock's velocity and moves its surface at once (the DEM's rate), on
+    /// top of the motion Bullet's last step gave it; at the end of the coupling step that motion goes back into
+    /// Bullet, whose step then takes only gravity and the rocks' contacts with rocks and steel (a multi-rate
+    /// scheme: Bullet at substeps x the DEM step). A sphere's rebound from a rock is then the same at any n, and
+    /// no rock runs away as one answering a coupling step late does. Machine parts keep the coupling-step
+    /// exchange (their motors and joints are Bullet's).
+    dem_step,
+};
+
 struct CouplingSettings {
     /// DEM steps per rigid-body step (DESIGN 1.3). 1 exchanges forces every DEM step; larger values give
     /// Bullet one step of substeps x the DEM step with the mean reaction of the sub-steps.
@@ -42,6 +56,7 @@ struct CouplingSettings {
     /// The runaway guard (kRunawayStreak and below). Off by default: it changes a run's bits wherever it acts,
     /// and in a falling column of the Table 1 mix it acts often (docs/coupling.md).
     bool runaway_guard = false;
+    RockExchange rock_exchange = RockExchange::coupling_step;
 };
 
 /// A rigid body the spheres touch, and what passed between the two at the last step.
@@ -175,6 +190,18 @@ private:
     void start();
     void check_pairs() const;
     void move_surfaces(double fraction, double interval_s);
+    /// RockExchange::dem_step: a rock's motion from the spheres since Bullet's last step, and what it takes.
+    struct RockResponse {
+        Vec3 velocity_m_per_s, angular_velocity_rad_per_s;  ///< world frame, added to Bullet's
+        Vec3 displacement_m, turn_rad;                      ///< of the centre; rotation vector, world frame
+        Mat3 inverse_inertia;                               ///< world frame, at Bullet's last step
+        double inverse_mass = 0.0;                          ///< 0: takes no response (not a rock, or frozen)
+    };
+    bool responds_at_dem_rate(std::size_t k) const;
+    /// At the start of an exchange: each rock's response from rest, its inertia at its pose after Bullet's step.
+    void start_responses();
+    /// After the last sub-step: each rock's response added to its pose and velocities in Bullet.
+    void hand_responses_to_rigid();
     /// The runaway guard's watch over the rocks at the end of a coupling step.
     void watch_for_runaways();
 
@@ -186,6 +213,7 @@ private:
     std::vector<Pose> before_, after_;
     std::vector<Vec3> spin_rad_;             ///< rotation vector from `before_` to `after_`
     std::vector<Vec3> force_sum_, torque_sum_;
+    std::vector<RockResponse> response_;  ///< RockExchange::dem_step; all zero between coupling steps
     /// The runaway guard's record of each coupled body (rocks only; `radius_of_gyration_m` 0 for others):
     /// velocities at the last coupling step's end, the velocity change over it, and the current streak.
     struct Watch {

@@ -333,6 +333,19 @@ void RigidWorld::set_frozen(BodyId id, bool frozen)
 
 bool RigidWorld::frozen(BodyId id) const { return impl_->body(id, "frozen").frozen; }
 
+void RigidWorld::set_rock_motion(BodyId id, const BodyState& s)
+{
+    Impl::Body& b = impl_->body(id, "set_rock_motion");
+    if (!b.is_rock() || b.frozen) throw InputError(concat("set_rock_motion: '", b.name, "' is not a free rock"));
+    if (!is_finite(s.position_m) || !is_finite(s.velocity_m_per_s) || !is_finite(s.angular_velocity_rad_per_s))
+        throw SimulationError(concat("rock '", b.name, "' was given a pose or velocity that is not finite at t = ", impl_->time_s, " s"));
+    btRigidBody& r = *b.body;
+    r.setLinearVelocity(to_bt(s.velocity_m_per_s));
+    r.setAngularVelocity(to_bt(s.angular_velocity_rad_per_s));
+    // the pose, the interpolation pose and velocities with it, and the inertia tensor in the world frame
+    r.setCenterOfMassTransform(btTransform(to_bt(s.rotation), to_bt(s.position_m)));
+}
+
 bool RigidWorld::is_dynamic(BodyId id) const
 {
     const Impl::Body& b = impl_->body(id, "is_dynamic");

@@ -115,6 +115,10 @@ public:
     /// (their manifolds are kept for when it is let go). Forces applied to it are ignored; it starts from rest.
     void set_frozen(BodyId rock, bool frozen);
     bool frozen(BodyId body) const;
+    /// Puts a rock (not frozen) at a new pose with new velocities between steps, as the coupling does when the
+    /// spheres have moved it at their own rate (coupling::RockExchange::dem_step). Its world inertia follows the
+    /// new orientation; its contacts are found again at the next step, as after any move.
+    void set_rock_motion(BodyId rock, const BodyState& state);
 
     // ---- the rope shovel (one per world)
     struct ShovelParts {

@@ -114,6 +114,8 @@ const std::vector<KeySpec>& scenario_keys()
         {"coupling", "map", "{}", "spheres with rigid bodies (rocks, the shovel)"},
         {"coupling.substeps", "integer", std::to_string(coupling::kDefaultSubsteps), "DEM steps per rigid-body step (docs/coupling.md)"},
         {"coupling.runaway_guard", "boolean", coupling::CouplingSettings{}.runaway_guard ? "true" : "false", "one DEM step per rigid-body step for a while when a rock runs away (docs/coupling.md)"},
+        {"coupling.rock_exchange", "string", "coupling_step",
+         "how rocks take the spheres' forces: coupling_step (the mean of the sub-steps, at Bullet's step) or dem_step (at every DEM step; Bullet's step then takes the rocks' own contacts only; docs/coupling.md)"},
 
         {"dynamic_domain", "map", "none", "freeze spheres and rocks at rest away from the machine and moving material (docs/coupling.md); none: every body moves"},
         {"dynamic_domain.margin_m", "number", "1.0", "how far from anything moving a body must be to freeze (cells this wide)"},
@@ -202,6 +204,7 @@ const std::vector<std::pair<std::string, std::string>>& library_settings_as_keys
         {"WorldSettings::step_s", "time.step_s"},
         {"CouplingSettings::substeps", "coupling.substeps"},
         {"CouplingSettings::runaway_guard", "coupling.runaway_guard"},
+        {"CouplingSettings::rock_exchange", "coupling.rock_exchange"},
     };
     return names;
 }

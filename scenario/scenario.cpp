@@ -398,6 +398,10 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     if (substeps < 1 || substeps > 100) coupling.fail("substeps", concat(substeps), "a whole number of DEM steps per rigid step, 1 to 100");
     s.coupling.substeps = static_cast<int>(substeps);
     s.coupling.runaway_guard = coupling.boolean("runaway_guard");
+    const std::string exchange = coupling.text("rock_exchange");
+    if (exchange == "coupling_step") s.coupling.rock_exchange = coupling::RockExchange::coupling_step;
+    else if (exchange == "dem_step") s.coupling.rock_exchange = coupling::RockExchange::dem_step;
+    else coupling.fail("rock_exchange", concat("\"", exchange, "\""), "coupling_step or dem_step");
     if (top.has("dynamic_domain")) {
         const MapReader d = top.map("dynamic_domain");
         coupling::DynamicDomainSettings& dd = s.dynamic_domain;

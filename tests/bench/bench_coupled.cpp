@@ -4,6 +4,8 @@
 // Usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]
 //                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]
 //                             [--turn N] [--full-mix]
+// --substeps: a list of n; "n:dem_step" runs n with the rocks taking the spheres' forces at every DEM step
+// (coupling::RockExchange::dem_step), plain n with the default exchange at Bullet's step.
 // --full-mix: the full-size loading model's mix on a tenth of its size (14,500 spheres of 200 mm and 2,000 rocks
 // of Table 1, settled 1.5 s, cached in bench_full_mix.state), coupled with the default sub-steps against the same
 // bed with the rocks held still, 1,000 timed DEM steps in turns of 100; other options given override these. Its
@@ -46,7 +48,8 @@ struct Bed {
     dem::World dem;
     rigid::RigidWorld rigid;
     coupling::CoupledWorld world;
-    Bed(double dt, int threads, int substeps, bool bullet_pairs, bool runaway_guard = false)
+    Bed(double dt, int threads, int substeps, bool bullet_pairs, bool runaway_guard = false,
+        coupling::RockExchange exchange = coupling::RockExchange::coupling_step)
         : dem(dem::MaterialTable::aitik_copper_ore(), [&] {
               dem::WorldSettings s;
               s.step_s = dt;
@@ -61,7 +64,7 @@ struct Bed {
               s.threads = threads;
               return s;
           }()),
-          world(dem, rigid, coupling::CouplingSettings{substeps, runaway_guard})
+          world(dem, rigid, coupling::CouplingSettings{substeps, runaway_guard, exchange})
     {
         rigid::add_aitik_copper_ore_materials(rigid);
     }
@@ -95,7 +98,7 @@ int main(int argc, char** argv)
     std::string pairs = "dipper", guard = "off";
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
-        "                            [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n"
+        "                            [--substeps 1,5,10,20,20:dem_step] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n"
         "                            [--turn N] [--full-mix]\n";
     // --full-mix is a flag: its settings first, the options given after it override them
     bool full_mix = false;
@@ -139,10 +142,20 @@ int main(int argc, char** argv)
     }
     const bool bullet_pairs = pairs == "bullet";
     std::vector<int> variants;
+    std::vector<coupling::RockExchange> exchanges;
     {
         std::stringstream ss(substeps_list);
         std::string item;
-        while (std::getline(ss, item, ',')) variants.push_back(std::atoi(item.c_str()));
+        while (std::getline(ss, item, ',')) {
+            const std::size_t colon = item.find(':');
+            variants.push_back(std::atoi(item.substr(0, colon).c_str()));
+            const std::string exchange = colon == std::string::npos ? "coupling_step" : item.substr(colon + 1);
+            if (exchange != "coupling_step" && exchange != "dem_step") {
+                std::fprintf(stderr, "--substeps: '%s'; expected n or n:dem_step\n", item.c_str());
+                return 2;
+            }
+            exchanges.push_back(exchange == "dem_step" ? coupling::RockExchange::dem_step : coupling::RockExchange::coupling_step);
+        }
     }
 
     // Table 1 rock classes in their mass ratios; the sphere fraction follows from the two counts
@@ -184,6 +197,7 @@ int main(int argc, char** argv)
     // every variant's bed, loaded from the cache and warmed up; then they take turns of --turn DEM steps each
     // until each has timed --steps (one turn by default: each variant in one go, as before)
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
+    exchanges.insert(exchanges.begin(), coupling::RockExchange::coupling_step);
     if (steps < 1) {
         std::fprintf(stderr, "--steps %d: expected a number of timed DEM steps >= 1\n", steps);
         return 2;
@@ -217,11 +231,13 @@ int main(int argc, char** argv)
         std::string failed;          ///< the error that stopped it
     };
     std::vector<Run> runs;
-    for (int n : variants) {
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+        const int n = variants[v];
+        const bool at_dem_rate = exchanges[v] == coupling::RockExchange::dem_step;
         Run r;
         r.n = n;
-        r.name = n == 0 ? "DEM only" : "n = " + std::to_string(n);
-        r.bed = std::make_unique<Bed>(dt, threads, std::max(n, 1), bullet_pairs, guard == "on");
+        r.name = n == 0 ? "DEM only" : "n = " + std::to_string(n) + (at_dem_rate ? ", rocks at the DEM's rate" : "");
+        r.bed = std::make_unique<Bed>(dt, threads, std::max(n, 1), bullet_pairs, guard == "on", exchanges[v]);
         r.bed->add_box(side, height + 1.0);
         coupling::load_state(r.bed->world, cache);
         runs.push_back(std::move(r));
@@ -294,13 +310,16 @@ int main(int argc, char** argv)
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     std::printf("peak memory %.0f MiB\n", u.ru_maxrss / 1024.0);
-    if (full_mix && runs.size() == 2 && runs[0].failed.empty() && runs[1].failed.empty()) {
+    // the full mix's summary, one line per coupled variant (the default's alone: the last line)
+    for (std::size_t v = 1; full_mix && v < runs.size(); ++v) {
         const Run& held = runs[0];
-        const Run& coupled = runs[1];
+        const Run& coupled = runs[v];
+        if (!held.failed.empty() || !coupled.failed.empty()) continue;
         std::vector<double> ratios;
         for (std::size_t k = 0; k < coupled.turn_s.size(); ++k) ratios.push_back(coupled.turn_s[k] / held.turn_s[k]);
         std::sort(ratios.begin(), ratios.end());
         const double median = 0.5 * (ratios[(ratios.size() - 1) / 2] + ratios[ratios.size() / 2]);
+        if (runs.size() > 2) std::printf("%s: ", coupled.name.c_str());
         std::printf("spheres: %zu rocks: %zu coupled: %.1f s/s rocks held: %.1f s/s ratio: %.2f\n", coupled.bed->dem.particles().size(),
                     coupled.bed->world.rocks().size(), coupled.wall / (coupled.bed->dem.time_s() - coupled.sim0),
                     held.wall / (held.bed->dem.time_s() - held.sim0), median);

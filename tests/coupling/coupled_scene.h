@@ -17,8 +17,9 @@ struct CoupledScene {
     rigid::RigidWorld rigid;
     coupling::CoupledWorld world;
 
-    CoupledScene(dem::MaterialTable table, dem::WorldSettings ds, rigid::RigidSettings rs, int substeps, bool runaway_guard = false)
-        : dem(std::move(table), ds), rigid(rs), world(dem, rigid, coupling::CouplingSettings{substeps, runaway_guard})
+    CoupledScene(dem::MaterialTable table, dem::WorldSettings ds, rigid::RigidSettings rs, int substeps, bool runaway_guard = false,
+                 coupling::RockExchange exchange = coupling::RockExchange::coupling_step)
+        : dem(std::move(table), ds), rigid(rs), world(dem, rigid, coupling::CouplingSettings{substeps, runaway_guard, exchange})
     {
         rigid::add_aitik_copper_ore_materials(rigid);
     }
@@ -26,13 +27,14 @@ struct CoupledScene {
 
 inline std::unique_ptr<CoupledScene> make_scene(int substeps, const Vec3& gravity = {0.0, 0.0, -9.81},
                                                 dem::MaterialTable table = dem::MaterialTable::aitik_copper_ore(),
-                                                bool runaway_guard = false)
+                                                bool runaway_guard = false,
+                                                coupling::RockExchange exchange = coupling::RockExchange::coupling_step)
 {
     dem::WorldSettings ds;
     ds.gravity_m_per_s2 = gravity;
     rigid::RigidSettings rs;
     rs.gravity_m_per_s2 = gravity;
-    return std::make_unique<CoupledScene>(std::move(table), ds, rs, substeps, runaway_guard);
+    return std::make_unique<CoupledScene>(std::move(table), ds, rs, substeps, runaway_guard, exchange);
 }
 
 inline constexpr double kSphereRadius = 0.1;  // the thesis' 200 mm spheres
