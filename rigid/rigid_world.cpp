@@ -456,6 +456,7 @@ void rigid_state_fields(IO& io, Impl& w, std::vector<std::uint8_t>& frozen)
                 b->body->setAngularVelocity(to_bt(omega));
                 b->body->setInterpolationLinearVelocity(to_bt(v));
                 b->body->setInterpolationAngularVelocity(to_bt(omega));
+                b->body->updateInertiaTensor();  // the world inertia follows the orientation read (a rock is made upright)
             }
         } else {
             btTransform t = b->previous_pose;

@@ -200,6 +200,13 @@ public:
             throw InputError(concat("--stop-after ", options_.stop_after_s, " s: the run is already at t = ", world_->time_s(),
                                     " s; give a later time"));
         require_reasonable_step_count(end_s - world_->time_s(), dt);
+        // this leg's wall clock by phase (summary.json) counts from here
+        phases_before_ = world_->phase_seconds();
+        rebuilds_before_ = world_->rebuild_count();
+        if (sim_) {
+            rigid_seconds_before_ = sim_->coupled().rigid_seconds();
+            surface_seconds_before_ = sim_->coupled().surface_seconds();
+        }
         try {
             while (!reached(end_s)) {
                 model_->step();
@@ -562,6 +569,21 @@ private:
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
             << "  \"state_hash\": \"" << hash << "\"";
+        {
+            // where this leg's wall clock went: the DEM's phases, Bullet's steps and the coupled surfaces' moves;
+            // "other" is the rest (outputs, probes, the machine's control, serial bookkeeping)
+            const dem::PhaseSeconds& p = w.phase_seconds();
+            const double rigid = sim_ ? sim_->coupled().rigid_seconds() - rigid_seconds_before_ : 0.0;
+            const double surface = sim_ ? sim_->coupled().surface_seconds() - surface_seconds_before_ : 0.0;
+            const double pairs = p.pair_forces - phases_before_.pair_forces, walls = p.wall_forces - phases_before_.wall_forces;
+            const double search = p.neighbour_search - phases_before_.neighbour_search, kicks = p.integration - phases_before_.integration;
+            out << ",\n  \"wall_clock_by_phase_s\": {\"sphere_pairs\": " << json_number(pairs) << ", \"walls_and_bodies\": "
+                << json_number(walls) << ", \"of_it_sphere_rock\": " << json_number(p.convex_forces - phases_before_.convex_forces)
+                << ", \"neighbour_search\": " << json_number(search) << ", \"integration\": " << json_number(kicks)
+                << ", \"rigid_bodies\": " << json_number(rigid) << ", \"surface_motion\": " << json_number(surface)
+                << ", \"other\": " << json_number(wall_s - pairs - walls - search - kicks - rigid - surface) << "}"
+                << ",\n  \"neighbour_rebuilds\": " << w.rebuild_count() - rebuilds_before_;
+        }
         if (sim_) write_rigid_summary(out);
         out << "\n}\n";
         finish_writing(out, dir_ + "/summary.json");
@@ -612,6 +634,9 @@ private:
     int snapshot_index_ = 0;
     double wall_seconds_before_ = 0.0;
     std::uint64_t steps_before_ = 0, last_row_step_ = ~0ull, row_step_ = ~0ull;
+    dem::PhaseSeconds phases_before_;
+    double rigid_seconds_before_ = 0.0, surface_seconds_before_ = 0.0;
+    std::uint64_t rebuilds_before_ = 0;
     coupling::LoadedState pile_;  ///< what the scenario's pile placed and left out
     double row_wall_s_ = 0.0;
     std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now(), last_progress_;

@@ -14,6 +14,14 @@ summary = json.load(open(os.path.join(folder, "summary.json")))
 assert summary["status"] == "completed", summary
 assert summary["rocks"] > 10, summary["rocks"]
 assert summary["passes"] == [], summary["passes"]
+# the run's wall clock by phase: each part at least 0, the rocks' share within the walls', Bullet's steps and the
+# surfaces' moves present (rocks and the shovel), everything but "other" adding up to at most the wall clock
+phases = summary["wall_clock_by_phase_s"]
+assert all(v >= 0.0 for k, v in phases.items() if k != "other"), phases
+assert phases["of_it_sphere_rock"] <= phases["walls_and_bodies"], phases
+assert phases["rigid_bodies"] > 0.0 and phases["surface_motion"] > 0.0 and phases["sphere_pairs"] > 0.0, phases
+assert phases["other"] >= -1e-6 * summary["wall_clock_s"], (phases, summary["wall_clock_s"])
+assert summary["neighbour_rebuilds"] >= 1, summary["neighbour_rebuilds"]  # at least the first step's
 assert "dipper" in summary["wear"] and summary["wear"]["dipper"]["law"] == "force_work", summary["wear"]
 by_region = summary["wear"]["dipper"]["volume_by_region_m3"]
 assert set(by_region) == {"bottom", "lip", "sides", "top", "teeth", "bars"}, by_region
