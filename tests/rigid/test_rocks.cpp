@@ -14,6 +14,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -312,6 +313,24 @@ TEST_CASE("rigid world: bad input gives clear errors", "[rigid][unit][bad_input]
     CHECK_THROWS_WITH(w.set_kinematic_pose(bucket, Mat3::identity(), {}), Catch::Contains("not a kinematic mesh"));
     CHECK_THROWS_WITH(w.set_pair("rock", "steel", 0.5, 1.5), Catch::Contains("restitution"));
     CHECK_THROWS_WITH(w.step(0.0), Catch::Contains("step_s"));
+    // a rock's motion set from outside (the coupling's rocks at the DEM's rate): only a free rock, only finite
+    const BodyId rock = w.add_rock(cube(0.3), 2700.0, 0, {3.0, 0.5, 1.0});
+    BodyState moved = w.state(rock);
+    CHECK_THROWS_WITH(w.set_rock_motion(bucket, moved), Catch::Contains("'bucket'") && Catch::Contains("not a free rock"));
+    moved.velocity_m_per_s.x = std::numeric_limits<double>::quiet_NaN();
+    CHECK_THROWS_WITH(w.set_rock_motion(rock, moved), Catch::Contains("not finite"));
+    w.set_frozen(rock, true);
+    CHECK_THROWS_WITH(w.set_rock_motion(rock, w.state(rock)), Catch::Contains("not a free rock"));
+    w.set_frozen(rock, false);
+    moved = w.state(rock);
+    moved.position_m = {3.0, 0.5, 2.0};
+    moved.rotation = rotation_about_axis({0.0, 0.0, 1.0}, 0.5);
+    moved.velocity_m_per_s = {1.0, 0.0, 0.0};
+    w.set_rock_motion(rock, moved);
+    const BodyState read = w.state(rock);
+    CHECK(read.position_m == moved.position_m);
+    CHECK(read.velocity_m_per_s == moved.velocity_m_per_s);
+    CHECK(read.rotation.m[0][1] == Approx(moved.rotation.m[0][1]).margin(1e-15));
     RigidSettings no_threads;
     no_threads.threads = 0;
     CHECK_THROWS_WITH(RigidWorld(no_threads), Catch::Contains("threads is 0") && Catch::Contains("1..1024"));
