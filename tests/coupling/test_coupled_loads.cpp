@@ -44,6 +44,29 @@ double bed_top_m(const dem::World& w)
     return top;
 }
 
+/// A sphere on a 0.4 m cube rock on Bullet's ground, for 1 s: the ground's contact force on the rock averaged over the
+/// last 0.1 s, over the weight of both, less 1; `contacts` the sphere-wall contacts at the end.
+double sphere_on_rock_on_ground(int n, coupling::RockExchange exchange, std::size_t& contacts)
+{
+    auto s = make_scene(n, {0.0, 0.0, -9.81}, dem::MaterialTable::aitik_copper_ore(), false, exchange);
+    s->rigid.add_ground_plane(0.0, s->rigid.material_index("ground"), "ground");
+    const rigid::BodyId rock = s->world.add_rock(cube(0.4), 3700.0, s->rigid.material_index("rock"),
+                                                 s->dem.materials().index_of("rock"), {0.0, 0.0, 0.2});
+    add_sphere(s->dem, {0.02, -0.01, 0.4 + kSphereRadius + 0.002});
+    const double weight = (s->rigid.mass_kg(rock) + s->dem.total_mass_kg()) * 9.81;
+    Vec3 sum;
+    int samples = 0;
+    while (s->world.time_s() < 1.0) {
+        s->world.step();
+        if (s->world.time_s() > 0.9) {
+            sum += s->rigid.contact_force_N(rock);
+            ++samples;
+        }
+    }
+    contacts = s->dem.wall_contact_count();
+    return (sum.z / samples) / weight - 1.0;
+}
+
 }  // namespace
 
 TEST_CASE("a sphere resting on a rock resting on the ground: the ground carries both", "[coupling][analytic]")
@@ -52,25 +75,11 @@ TEST_CASE("a sphere resting on a rock resting on the ground: the ground carries 
     // contact force on the rock, averaged over the last 0.1 s, equals (m_rock + m_sphere) g within 1 %.
     std::printf("sphere on rock on ground: n, ground load / total weight - 1\n");
     for (int n : {1, 5, 20}) {
-        auto s = make_scene(n);
-        s->rigid.add_ground_plane(0.0, s->rigid.material_index("ground"), "ground");
-        const rigid::BodyId rock = s->world.add_rock(cube(0.4), 3700.0, s->rigid.material_index("rock"),
-                                                     s->dem.materials().index_of("rock"), {0.0, 0.0, 0.2});
-        add_sphere(s->dem, {0.02, -0.01, 0.4 + kSphereRadius + 0.002});
-        const double weight = (s->rigid.mass_kg(rock) + s->dem.total_mass_kg()) * 9.81;
-        Vec3 sum;
-        int samples = 0;
-        while (s->world.time_s() < 1.0) {
-            s->world.step();
-            if (s->world.time_s() > 0.9) {
-                sum += s->rigid.contact_force_N(rock);
-                ++samples;
-            }
-        }
-        const double error = (sum.z / samples) / weight - 1.0;
+        std::size_t contacts = 0;
+        const double error = sphere_on_rock_on_ground(n, coupling::RockExchange::coupling_step, contacts);
         std::printf("  n = %2d  %+.2e\n", n, error);
         CHECK(std::abs(error) < 0.01);
-        CHECK(s->dem.wall_contact_count() == 1);  // the sphere is still on the rock
+        CHECK(contacts == 1);  // the sphere is still on the rock
     }
 }
 
@@ -320,25 +329,11 @@ TEST_CASE("rocks that take the spheres' forces at every DEM step: static loads a
     for (int n : {5, 20}) {
         INFO("n = " << n);
         {  // a sphere on a rock on Bullet's ground: the ground's force on the rock, averaged over the last 0.1 s
-            auto s = make_scene(n, {0.0, 0.0, -9.81}, dem::MaterialTable::aitik_copper_ore(), false, RockExchange::dem_step);
-            s->rigid.add_ground_plane(0.0, s->rigid.material_index("ground"), "ground");
-            const rigid::BodyId rock = s->world.add_rock(cube(0.4), 3700.0, s->rigid.material_index("rock"),
-                                                         s->dem.materials().index_of("rock"), {0.0, 0.0, 0.2});
-            add_sphere(s->dem, {0.02, -0.01, 0.4 + kSphereRadius + 0.002});
-            const double weight = (s->rigid.mass_kg(rock) + s->dem.total_mass_kg()) * 9.81;
-            Vec3 sum;
-            int samples = 0;
-            while (s->world.time_s() < 1.0) {
-                s->world.step();
-                if (s->world.time_s() > 0.9) {
-                    sum += s->rigid.contact_force_N(rock);
-                    ++samples;
-                }
-            }
-            const double error = (sum.z / samples) / weight - 1.0;
+            std::size_t contacts = 0;
+            const double error = sphere_on_rock_on_ground(n, RockExchange::dem_step, contacts);
             std::printf("rocks at the DEM's rate, n = %2d: sphere on rock on ground, ground load / weight - 1 = %+.2e\n", n, error);
             CHECK(std::abs(error) < 0.01);
-            CHECK(s->dem.wall_contact_count() == 1);
+            CHECK(contacts == 1);
         }
         {  // a rock on a bed of spheres: the floor carries everything, the spheres hold the rock up
             auto s = make_scene(n, {0.0, 0.0, -9.81}, dem::MaterialTable::aitik_copper_ore(), false, RockExchange::dem_step);

@@ -192,6 +192,8 @@ TEST_CASE("every class of scenario error names file, line, column, key, value an
     // a form of rolling resistance that dipper does not have
     e = error_of(small_scenario() + "materials:\n  rolling_resistance: constant\n");
     CHECK_THAT(e, Catch::Contains("materials.rolling_resistance: got \"constant\"; expected relative_spring or own_spin"));
+    e = error_of(small_scenario() + "coupling:\n  rock_exchange: sometimes\n");
+    CHECK_THAT(e, Catch::Contains("coupling.rock_exchange: got \"sometimes\"; expected coupling_step or dem_step"));
 }
 
 TEST_CASE("a mesh file that cannot be read names the scenario entry", "[scenario]")
