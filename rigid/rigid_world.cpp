@@ -482,6 +482,8 @@ void RigidWorld::write_state(StateWriter& out) const
     for (const auto& b : w.bodies) frozen.push_back(b->frozen ? 1 : 0);
     rigid_state_fields(out, w, frozen);
     if (w.shovel) write_shovel_state(*w.shovel, out);
+    for (const auto& b : w.bodies) out(b->touching, b->touching_step);
+    write_contact_state(w, out);
 }
 
 void RigidWorld::read_state(StateReader& in)
@@ -506,6 +508,8 @@ void RigidWorld::read_state(StateReader& in)
     }
     if (w.shovel) read_shovel_state(*w.shovel, in, w.step_s);
     if (w.contact_force.size() != w.bodies.size()) in.fail("rigid contact forces of another number of bodies");
+    for (auto& b : w.bodies) in(b->touching, b->touching_step);
+    read_contact_state(w, in);
 }
 
 double RigidWorld::last_step_s() const { return impl_->step_s; }

@@ -149,8 +149,9 @@ public:
 
     // ---- checkpoints
     /// Writes the moving state: time, every rock's and kinematic part's pose and velocities, the shovel's
-    /// joints, ropes and force filter. Bullet's contact caches (warm starting) are not part of it, so a
-    /// run continued from it follows the uninterrupted run closely but not bit for bit.
+    /// joints, ropes and force filter, and Bullet's contact history (its broad phase, pairs, manifolds with
+    /// their warm-starting impulses, in their order), so that a run continued from it takes the same steps as
+    /// the uninterrupted run, bit for bit, on the same build and thread count.
     void write_state(StateWriter& out) const;
     /// Reads what write_state wrote into a world built the same way (same bodies in the same order);
     /// anything else is an InputError naming what differs.

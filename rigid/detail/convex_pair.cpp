@@ -5,6 +5,7 @@
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <new>
 
@@ -157,6 +158,42 @@ public:
         if (!near(s) && result->m_closestPointDistanceThreshold == 0) start_apart(body0, body1, s);
     }
 
+    ConvexPairState state() const
+    {
+        ConvexPairState s;
+        std::memset(static_cast<void*>(&s), 0, sizeof s);  // the padding too: a checkpoint's bytes depend on the state only
+        s.manifold = manifold_ ? 1 : 0;
+        s.apart = apart_ ? 1 : 0;
+        s.gap = gap_;
+        for (int k = 0; k < 3; ++k) s.normal[k] = normal_[k];
+        s.along_a = along_a_;
+        s.along_b = along_b_;
+        for (int k = 0; k < 9; ++k) {
+            s.rotation_a[k] = rotation_a_[k];
+            s.rotation_b[k] = rotation_b_[k];
+        }
+        s.radius_a = radius_a_;
+        s.radius_b = radius_b_;
+        return s;
+    }
+
+    void set_state(const ConvexPairState& s, const btCollisionObject* body0, const btCollisionObject* body1)
+    {
+        if (manifold_) m_dispatcher->releaseManifold(manifold_);
+        manifold_ = s.manifold ? m_dispatcher->getNewManifold(body0, body1) : nullptr;
+        apart_ = s.apart != 0;
+        gap_ = s.gap;
+        for (int k = 0; k < 3; ++k) normal_[k] = s.normal[k];
+        along_a_ = s.along_a;
+        along_b_ = s.along_b;
+        for (int k = 0; k < 9; ++k) {
+            rotation_a_[k] = s.rotation_a[k];
+            rotation_b_[k] = s.rotation_b[k];
+        }
+        radius_a_ = s.radius_a;
+        radius_b_ = s.radius_b;
+    }
+
     btScalar calculateTimeOfImpact(btCollisionObject*, btCollisionObject*, const btDispatcherInfo&, btManifoldResult*) override
     {
         return 1;  // no continuous collision detection: the step is small against the rocks
@@ -253,6 +290,15 @@ btCollisionAlgorithm* ConvexPairCreateFunc::CreateCollisionAlgorithm(btCollision
 double convex_pair_apart_margin(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1)
 {
     return static_cast<const ConvexPair&>(pair).apart_margin(body0.getWorldTransform(), body1.getWorldTransform());
+}
+
+bool is_convex_pair(const btCollisionAlgorithm& algorithm) { return dynamic_cast<const ConvexPair*>(&algorithm) != nullptr; }
+
+ConvexPairState convex_pair_state(const btCollisionAlgorithm& pair) { return static_cast<const ConvexPair&>(pair).state(); }
+
+void set_convex_pair_state(btCollisionAlgorithm& pair, const ConvexPairState& state, const btCollisionObject* body0, const btCollisionObject* body1)
+{
+    static_cast<ConvexPair&>(pair).set_state(state, body0, body1);
 }
 
 float hull_motion_radius(const btCollisionShape& shape)

@@ -5,6 +5,8 @@
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
 
+#include <cstdint>
+
 namespace dipper::rigid {
 
 /// Creates ConvexPair algorithms for the hull-hull pairs of one dispatcher. Register it with
@@ -36,6 +38,20 @@ struct ConvexPairSearch {
 double convex_pair_apart_margin(const btCollisionAlgorithm& pair, const btCollisionObject& body0, const btCollisionObject& body1);
 /// The radius a ConvexPair's gap bound turns a hull by: its angular motion disc, rounded up to a float.
 float hull_motion_radius(const btCollisionShape& shape);
+
+/// A ConvexPair between steps, as a checkpoint keeps it: whether it holds a manifold (whose points are kept with
+/// the manifold), and the gap bound of a pair found apart.
+struct ConvexPairState {
+    std::uint8_t manifold = 0, apart = 0;
+    double gap = 0.0, normal[3] = {0.0, 0.0, 0.0}, along_a = 0.0, along_b = 0.0;
+    float rotation_a[9] = {}, rotation_b[9] = {}, radius_a = 0.0f, radius_b = 0.0f;
+};
+/// Whether a collision algorithm is a ConvexPair.
+bool is_convex_pair(const btCollisionAlgorithm& algorithm);
+ConvexPairState convex_pair_state(const btCollisionAlgorithm& pair);
+/// Gives a ConvexPair made for the same two bodies the state another one had; with a manifold, a new empty one
+/// of body0 and body1 (as the pair's own making gives it), for the caller to fill.
+void set_convex_pair_state(btCollisionAlgorithm& pair, const ConvexPairState& state, const btCollisionObject* body0, const btCollisionObject* body1);
 
 /// What is left of a pair's processCollision after the part that touches only its own manifold.
 enum class ManifoldChange { none, make, release };

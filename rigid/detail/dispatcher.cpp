@@ -286,6 +286,52 @@ void Dispatcher::dispatchAllCollisionPairs(btOverlappingPairCache* pairs, const 
     }
 }
 
+void Dispatcher::write_odometers(StateWriter& out) const
+{
+    out.tag("odometers");
+    std::vector<std::uint8_t> known;
+    std::vector<double> previous;
+    for (std::size_t u = 0; u < shape_.size(); ++u) {
+        known.push_back(shape_[u] ? 1 : 0);
+        const btTransform& t = previous_[u];
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) previous.push_back(t.getBasis()[r][c]);
+        for (int c = 0; c < 3; ++c) previous.push_back(t.getOrigin()[c]);
+    }
+    out(odometer_, known, previous, thresholds_set_);
+}
+
+void Dispatcher::read_odometers(StateReader& in)
+{
+    in.tag("odometers");
+    std::vector<double> odometer, previous;
+    std::vector<std::uint8_t> known;
+    bool thresholds = false;
+    in(odometer, known, previous, thresholds);
+    if (known.size() != odometer.size() || previous.size() != 12 * odometer.size()) in.fail("odometers of another number of bodies");
+    // each known proxy's shape is its object's now (a shape, once given, is never changed)
+    std::vector<const btCollisionShape*> shape(odometer.size(), nullptr);
+    if (objects_)
+        for (int i = 0; i < objects_->size(); ++i) {
+            const btCollisionObject* o = (*objects_)[i];
+            const btBroadphaseProxy* h = o->getBroadphaseHandle();
+            if (!h || h->m_uniqueId < 0 || static_cast<std::size_t>(h->m_uniqueId) >= odometer.size()) continue;
+            if (known[static_cast<std::size_t>(h->m_uniqueId)]) shape[static_cast<std::size_t>(h->m_uniqueId)] = o->getCollisionShape();
+        }
+    for (std::size_t u = 0; u < known.size(); ++u)
+        if (known[u] && !shape[u]) in.fail(concat("an odometer of body proxy ", u, ", which the world does not have"));
+    odometer_ = std::move(odometer);
+    shape_ = std::move(shape);
+    radius_.assign(shape_.size(), 0.0);
+    previous_.assign(shape_.size(), btTransform::getIdentity());
+    for (std::size_t u = 0; u < shape_.size(); ++u) {
+        if (shape_[u]) radius_[u] = hull_motion_radius(*shape_[u]);
+        const double* p = &previous[12 * u];
+        previous_[u] = btTransform(btMatrix3x3(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8]), btVector3(p[9], p[10], p[11]));
+    }
+    thresholds_set_ = thresholds;
+}
+
 void* Dispatcher::allocateCollisionAlgorithm(int size)
 {
     if (!parallel_) return btCollisionDispatcher::allocateCollisionAlgorithm(size);

@@ -2,6 +2,7 @@
 // outside rigid/ includes it.
 #pragma once
 
+#include "core/state_io.h"
 #include "rigid/detail/convex_pair.h"
 
 #include <btBulletCollisionCommon.h>
@@ -42,9 +43,17 @@ public:
     bool needsCollision(const btCollisionObject* body0, const btCollisionObject* body1) override
     {
         auto fixed = [](const btCollisionObject* o) { return o->isStaticObject() && !o->isKinematicObject(); };
-        if (fixed(body0) && fixed(body1)) return false;
+        if (fixed(body0) && fixed(body1) && !restoring_) return false;
         return btCollisionDispatcher::needsCollision(body0, body1);
     }
+
+    /// While a checkpoint's contacts are put back (rigid/detail/contact_state.cpp), the pairs of two fixed bodies
+    /// are made as when one of them was still free: a frozen rock's algorithms and manifolds as it left them.
+    void set_restoring(bool restoring) { restoring_ = restoring; }
+    /// The odometers and whether thresholds are kept, for checkpoints: the proxies' unique ids are the same in a
+    /// world built the same way, so they are kept by id.
+    void write_odometers(StateWriter& out) const;
+    void read_odometers(StateReader& in);
 
     // the algorithm pool is shared: locked while pass 1 runs (a hull against a mesh makes one per triangle)
     void* allocateCollisionAlgorithm(int size) override;
@@ -80,6 +89,7 @@ private:
     std::vector<btTransform> previous_;
     std::vector<const btCollisionShape*> shape_;
     bool thresholds_set_ = false;  ///< some pair holds a threshold (the two-pass dispatch ran)
+    bool restoring_ = false;
 };
 
 }  // namespace dipper::rigid

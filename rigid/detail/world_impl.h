@@ -244,4 +244,9 @@ void read_shovel_state(ShovelState& s, StateReader& in, double last_step_s);
 void shovel_before_step(RigidWorld::Impl& world, double time_after_step_s);
 void shovel_after_step(RigidWorld::Impl& world);
 
+/// Bullet's contact history (broad phase, pairs, algorithms, manifolds, odometers) into a checkpoint and back
+/// into a world built the same way, so that a resumed run takes the same steps (contact_state.cpp).
+void write_contact_state(const RigidWorld::Impl& w, StateWriter& out);
+void read_contact_state(RigidWorld::Impl& w, StateReader& in);
+
 }  // namespace dipper::rigid
