@@ -166,6 +166,13 @@ void each_manifold(btCollisionAlgorithm* algorithm, Visit visit)
     for (int k = 0; k < found.size(); ++k) visit(found[k], -1, k);
 }
 
+/// The broad phase's counters between steps, listed once for writing, reading and putting back.
+auto counters(btDbvtBroadphase& bp)
+{
+    return std::tie(bp.m_stageCurrent, bp.m_fupdates, bp.m_dupdates, bp.m_cupdates, bp.m_newpairs, bp.m_fixedleft, bp.m_updates_call,
+                    bp.m_updates_done, bp.m_updates_ratio, bp.m_pid, bp.m_cid, bp.m_gid, bp.m_needcleanup);
+}
+
 std::int32_t code_of(btCollisionAlgorithm* a) { return !a ? kNone : is_convex_pair(*a) ? kConvexPair : as_compound(a) ? kCompound : kOther; }
 
 }  // namespace
@@ -196,8 +203,7 @@ void write_contact_state(const RigidWorld::Impl& impl, StateWriter& out)
         for (const btDbvtProxy* p = root; p; p = p->links[1]) list.push_back(body_id(static_cast<const btCollisionObject*>(p->m_clientObject)));
         out(list);
     }
-    out(bp.m_stageCurrent, bp.m_fupdates, bp.m_dupdates, bp.m_cupdates, bp.m_newpairs, bp.m_fixedleft, bp.m_updates_call, bp.m_updates_done,
-        bp.m_updates_ratio, bp.m_pid, bp.m_cid, bp.m_gid, bp.m_needcleanup);
+    std::apply([&](const auto&... c) { out(c...); }, counters(bp));
 
     // the pairs in their order, each with its algorithm; ConvexPairs' states in the order met
     btBroadphasePairArray& pairs = bp.getOverlappingPairCache()->getOverlappingPairArray();
@@ -311,13 +317,12 @@ void read_contact_state(RigidWorld::Impl& w, StateReader& in)
     }
     for (std::size_t b = 0; b < n; ++b)
         if (!listed[b]) in.fail(concat("rigid body '", w.bodies[b]->name, "' in no broad-phase stage list"));
-    int stage_current = 0, fixed_updates = 0, dynamic_updates = 0, cleanup_updates = 0, new_pairs = 0, fixed_left = 0, parse = 0, cleanup = 0,
-        generation = 0;
-    unsigned updates_call = 0, updates_done = 0;
-    btScalar updates_ratio = 0;
-    bool need_cleanup = false;
-    in(stage_current, fixed_updates, dynamic_updates, cleanup_updates, new_pairs, fixed_left, updates_call, updates_done, updates_ratio, parse,
-       cleanup, generation, need_cleanup);
+    // the counters read into copies, put back once everything is checked
+    auto read = std::apply([](const auto&... c) { return std::make_tuple(c...); }, counters(bp));
+    std::apply([&](auto&... c) { in(c...); }, read);
+    const auto& [stage_current, fixed_updates, dynamic_updates, cleanup_updates, new_pairs, fixed_left, calls, done, ratio, parse, cleanup,
+                 generation, need_cleanup] = read;
+    (void)calls, (void)done, (void)ratio, (void)parse, (void)need_cleanup;  // statistics and flags: any value will do
     if (stage_current < 0 || stage_current >= btDbvtBroadphase::STAGECOUNT) in.fail(concat("a broad-phase stage of ", stage_current));
     for (int percent : {fixed_updates, dynamic_updates, cleanup_updates})
         if (percent < 0 || percent > 100) in.fail(concat("a broad-phase update share of ", percent, " %"));
@@ -403,19 +408,7 @@ void read_contact_state(RigidWorld::Impl& w, StateReader& in)
             previous = p;
         }
     }
-    bp.m_stageCurrent = stage_current;
-    bp.m_fupdates = fixed_updates;
-    bp.m_dupdates = dynamic_updates;
-    bp.m_cupdates = cleanup_updates;
-    bp.m_newpairs = new_pairs;
-    bp.m_fixedleft = fixed_left;
-    bp.m_updates_call = updates_call;
-    bp.m_updates_done = updates_done;
-    bp.m_updates_ratio = updates_ratio;
-    bp.m_pid = parse;
-    bp.m_cid = cleanup;
-    bp.m_gid = generation;
-    bp.m_needcleanup = need_cleanup;
+    counters(bp) = read;
 
     // the pairs in their order, and their algorithms as the dispatcher makes them (a frozen rock's as when it
     // was free), given their state
