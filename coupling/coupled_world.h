@@ -209,6 +209,7 @@ private:
     rigid::RigidWorld& rigid_;
     CouplingSettings settings_;
     std::vector<CoupledBody> bodies_;
+    std::vector<int> index_by_body_;  ///< by rigid body id: its index in bodies_, or -1 (index_of, once per rock per step)
     std::vector<RockRecord> rocks_;
     std::vector<Pose> before_, after_;
     std::vector<Vec3> spin_rad_;             ///< rotation vector from `before_` to `after_`

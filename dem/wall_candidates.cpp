@@ -10,8 +10,13 @@
 namespace dipper::dem {
 
 void WallCandidates::build(const CellGrid& grid, const ParticleStore& particles, double skin_m, const WallSet& walls,
-                           ConvexPairs& convex, int threads)
+                           ConvexPairs& convex, int threads, const CandidateCarry* carry)
 {
+    carried_ = 0;
+    if (carry) {
+        old_start_.swap(start_);
+        old_all_.swap(all_);
+    }
     const Vec3& lo = grid.lo;
     const double cell = grid.cell;
     const int* dims = grid.dims;
@@ -95,7 +100,9 @@ void WallCandidates::build(const CellGrid& grid, const ParticleStore& particles,
     const int blocks = threads == 1 ? 1 : 16 * threads;
     per_block.resize(static_cast<std::size_t>(blocks));
     std::vector<std::uint32_t> counts(n, 0);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    const bool may_carry = carry && old_start_.size() == carry->unmoved.size() + 1 && carry->unmoved.size() == n;
+    std::size_t carried = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : carried)
     for (int b = 0; b < blocks; ++b) {
         std::size_t begin, end;
         thread_block(n, b, blocks, begin, end);
@@ -106,6 +113,22 @@ void WallCandidates::build(const CellGrid& grid, const ParticleStore& particles,
             int c[3];
             for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - lo[a]) / cell), 0, dims[a] - 1);
             const auto cid = static_cast<std::size_t>((static_cast<std::size_t>(c[2]) * dims[1] + c[1]) * dims[0] + c[0]);
+            if (may_carry && carry->unmoved[i]) {
+                // Every mesh that may lie within reach now is binned into this cell, and every one within reach
+                // then is among the old candidates: none of them posed since, the search would find the same list
+                const std::uint32_t o = carry->old_index[i];
+                bool same = true;
+                for (std::uint32_t k = bucket_count[cid]; k < bucket_count[cid + 1] && same; ++k)
+                    same = carry->mesh_unchanged[bucket[k].mesh] != 0;
+                for (std::uint32_t k = old_start_[o]; k < old_start_[o + 1] && same; ++k)
+                    same = old_all_[k].triangle == kPlaneCandidate || carry->mesh_unchanged[old_all_[k].mesh] != 0;
+                if (same) {
+                    out.insert(out.end(), old_all_.begin() + old_start_[o], old_all_.begin() + old_start_[o + 1]);
+                    counts[i] = old_start_[o + 1] - old_start_[o];
+                    ++carried;
+                    continue;
+                }
+            }
             const double range = particles.radius_m[i] + skin_m;
             for (std::size_t q = 0; q < walls.planes.size(); ++q)
                 if (dot(p, walls.planes[q].normal) - walls.plane_offset_m[q] < range && !walls.wall_removed[static_cast<std::size_t>(walls.plane_wall_id[q])]) {
@@ -145,6 +168,7 @@ void WallCandidates::build(const CellGrid& grid, const ParticleStore& particles,
         }
         per_block[static_cast<std::size_t>(b)] = std::move(out);
     }
+    carried_ = carried;
     for (std::size_t i = 0; i < n; ++i) start_[i + 1] = start_[i] + counts[i];
     for (const auto& v : per_block) all_.insert(all_.end(), v.begin(), v.end());
     split(walls.meshes, convex, threads);
@@ -269,6 +293,7 @@ void WallCandidates::write_state(StateWriter& out) const { out(start_, all_); }
 void WallCandidates::read_state(StateReader& in, std::size_t planes, const std::vector<MeshWall>& meshes)
 {
     in(start_, all_);
+    carried_ = 0;
     if (!start_.empty() && start_.back() != all_.size()) in.fail("wall candidate index mismatch");
     if (!std::is_sorted(start_.begin(), start_.end())) in.fail("a wall contact or candidate index that does not ascend");
     for (const MeshCandidate& c : all_) {

@@ -39,13 +39,25 @@ struct WallHit {
     bool keep;  ///< false for a hit that is not a contact of its own (the same point, or not a local minimum)
 };
 
+/// What a build may take over from the one before it. A particle that sits bit for bit where it sat then, with the
+/// same radius and skin, among meshes none of which has been posed since, has the same candidates (the search is
+/// exact and does not depend on the grid): a frozen bed's spheres among frozen rocks (coupling::DynamicDomain).
+struct CandidateCarry {
+    const std::vector<std::uint32_t>& old_index;     ///< by particle, in the new order: its index at the last build
+    const std::vector<std::uint8_t>& unmoved;        ///< by particle, in the new order: position and radius unchanged
+    const std::vector<std::uint8_t>& mesh_unchanged; ///< by mesh: not posed since the last build (meshes not added)
+};
+
 class WallCandidates {
 public:
     /// Finds every particle's candidates in the cells of `grid` (the particles sorted by cell) and splits them
     /// (split). A mesh's triangles are binned by their inflated bounding boxes, a convex body as a whole by its
-    /// bounding sphere.
+    /// bounding sphere. With `carry`, a particle it marks unmoved keeps its last candidates when every mesh binned
+    /// into its cell and every mesh among them is unchanged (the same candidates as a search would find).
     void build(const CellGrid& grid, const ParticleStore& particles, double skin_m, const WallSet& walls, ConvexPairs& convex,
-               int threads);
+               int threads, const CandidateCarry* carry = nullptr);
+    /// Particles whose candidates the last build took over rather than searched.
+    std::size_t carried() const { return carried_; }
     /// Makes the pairs of spheres and convex bodies, and the per-particle lists of planes and open meshes'
     /// triangles, from the candidates.
     void split(const std::vector<MeshWall>& meshes, ConvexPairs& convex, int threads);
@@ -89,6 +101,9 @@ private:
     std::vector<std::pair<std::uint32_t, MeshCandidate>> entries_;  ///< (cell, triangle)
     std::vector<MeshCandidate> bucket_;                             ///< triangles by cell
     std::vector<std::vector<MeshCandidate>> per_block_;
+    std::vector<std::uint32_t> old_start_;  ///< the last build's start_ and all_ while a build takes from them
+    std::vector<MeshCandidate> old_all_;
+    std::size_t carried_ = 0;
 };
 
 }  // namespace dipper::dem

@@ -415,16 +415,34 @@ void World::rebuild()
 {
     const std::size_t n = particles_.size();
     ++rebuild_count_;
-    rebuild_needed_ = false;
     double r_max = 0.0;
     for (double r : particles_.radius_m) r_max = std::max(r_max, r);
+    const double old_skin_m = skin_m_;
     skin_m_ = settings_.skin_fraction_of_radius * r_max;
+
+    // The particles that sit bit for bit where they sat at the last rebuild (the frozen ones), by their index then:
+    // their wall candidates may be taken over. Not after particles or walls came or went (rebuild_needed_), nor
+    // after a checkpoint was read (the reference radii are not kept in it).
+    const bool may_carry = settings_.carry_wall_candidates && !rebuild_needed_ && skin_m_ == old_skin_m && reference_position_m_.size() == n &&
+                           reference_radius_m_.size() == n && reference_mesh_version_.size() == meshes_.size();
+    rebuild_needed_ = false;
+    std::vector<std::uint8_t> unmoved;
+    if (may_carry) {
+        unmoved.resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+            unmoved[i] = particles_.position_m[i] == reference_position_m_[i] && particles_.radius_m[i] == reference_radius_m_[i];
+    }
 
     // the cell grid over the particles, and their order sorted by cell
     std::vector<std::uint32_t> order, old_to_new(n);
     const CellGrid grid = CellGrid::sorting(particles_.position_m, 2.0 * r_max + skin_m_, order);
     for (std::size_t k = 0; k < n; ++k) old_to_new[order[k]] = static_cast<std::uint32_t>(k);
     particles_.permute(order);
+    if (may_carry) {
+        std::vector<std::uint8_t> by_new(n);
+        for (std::size_t k = 0; k < n; ++k) by_new[k] = unmoved[order[k]];
+        unmoved.swap(by_new);
+    }
     stiffness_radius_N_per_m_.resize(n);
     for (std::size_t i = 0; i < n; ++i)
         stiffness_radius_N_per_m_[i] = bulk_modulus_Pa_[particles_.material[i]] * particles_.radius_m[i];
@@ -442,12 +460,19 @@ void World::rebuild()
 
     // planes and triangles near each particle, and the pairs of spheres and convex bodies, which take the
     // history of their contacts
-    candidates_.build(grid, particles_, skin_m_, wall_set(),
-                      convex_, threads_);
+    if (may_carry) {
+        std::vector<std::uint8_t> mesh_unchanged(meshes_.size());
+        for (std::size_t m = 0; m < meshes_.size(); ++m) mesh_unchanged[m] = meshes_[m].pose_version() == reference_mesh_version_[m];
+        const CandidateCarry carry{order, unmoved, mesh_unchanged};
+        candidates_.build(grid, particles_, skin_m_, wall_set(), convex_, threads_, &carry);
+    } else {
+        candidates_.build(grid, particles_, skin_m_, wall_set(), convex_, threads_);
+    }
     convex_contact_count_ = 0;
     split_convex_contacts();
 
     reference_position_m_ = particles_.position_m;
+    reference_radius_m_ = particles_.radius_m;
     reference_mesh_rotation_.resize(meshes_.size());
     reference_mesh_translation_m_.resize(meshes_.size());
     reference_mesh_version_.resize(meshes_.size());

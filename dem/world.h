@@ -34,6 +34,10 @@ struct WorldSettings {
     int threads = 1;                         ///< OpenMP threads; 0 takes OMP_NUM_THREADS / all cores
     double max_overlap_ratio = 0.5;          ///< stop with a diagnosis when overlap / smaller radius exceeds it
     double initial_overlap_tolerance = 0.01; ///< initial overlaps above this fraction of the smaller radius are refused
+    /// At a rebuild, a particle that has not moved since the last one (a frozen one) keeps its walls within reach when
+    /// no mesh near it has moved either: the same lists a search finds, for a fraction of the cost in a frozen bed.
+    /// false searches every particle's walls at every rebuild (what the carried lists are checked and timed against).
+    bool carry_wall_candidates = true;
 };
 
 /// Reference time step sqrt(m / K) (thesis: dt = c_dt sqrt(m/k)) and its factors.
@@ -87,6 +91,8 @@ public:
     void set_wall_frozen(int wall_id, bool frozen);
     bool wall_frozen(int wall_id) const;
     std::size_t frozen_count() const;  ///< frozen particles
+    /// Particles whose walls within reach the last rebuild carried over instead of searching (WorldSettings).
+    std::size_t carried_wall_candidates() const { return candidates_.carried(); }
 
     // ---- running -------------------------------------------------------------------------------
     /// Advances one step: half kick and drift, walls moved, neighbour lists refreshed if needed,
@@ -229,6 +235,7 @@ private:
 
     SpherePairs pairs_;  ///< the neighbour list of sphere pairs with their contact history and forces
     std::vector<Vec3> reference_position_m_;
+    std::vector<double> reference_radius_m_;        ///< at the last rebuild; not in a checkpoint (nothing carried after one)
     std::vector<double> stiffness_radius_N_per_m_;  ///< k r per particle (eq. 4), refreshed at each rebuild
     std::vector<Mat3> reference_mesh_rotation_;     ///< each mesh's pose at the last rebuild
     std::vector<Vec3> reference_mesh_translation_m_;

@@ -13,10 +13,15 @@ using namespace dipper::test;
 
 namespace {
 
-/// A square bed of 200 mm spheres, two layers on the ground (x, y in [0, 0.2 n)), with a rock on it if asked.
-std::unique_ptr<CoupledScene> bed(int n, bool rock)
+/// A square bed of 200 mm spheres, two layers on the ground (x, y in [0, 0.2 n)), with a rock on it if asked; `carry`
+/// as dem::WorldSettings::carry_wall_candidates.
+std::unique_ptr<CoupledScene> bed(int n, bool rock, bool carry = true)
 {
-    auto s = make_scene(5);
+    dem::WorldSettings ds;
+    ds.carry_wall_candidates = carry;
+    rigid::RigidSettings rs;
+    rs.gravity_m_per_s2 = ds.gravity_m_per_s2;
+    auto s = std::make_unique<CoupledScene>(dem::MaterialTable::aitik_copper_ore(), ds, rs, 5);
     const auto ground = s->dem.materials().index_of("ground");
     s->dem.add_plane({0, 0, 0}, {0, 0, 1}, ground, "ground");
     s->rigid.add_ground_plane(0.0, s->rigid.material_index("ground"), "ground");
@@ -115,6 +120,39 @@ TEST_CASE("a sphere thrown at a frozen bed lets go what it comes near, and only 
     // and once all is still again, it freezes again
     run_for(*s, d, 1.0);
     CHECK(d.frozen_spheres() == s->dem.particles().size());
+}
+
+TEST_CASE("a frozen bed's walls carried over at a rebuild give the bits of a search", "[coupling][dynamic_domain]")
+{
+    // The same bed twice, one searching every sphere's walls at every rebuild: frozen with its rock, then hit at one
+    // corner by a sphere thrown from 2 m, whose fall and landing rebuild the lists every few steps
+    auto a = bed(12, true, true), b = bed(12, true, false);
+    coupling::DynamicDomain da({true, 0.5, 0.05, 0.1}), db({true, 0.5, 0.05, 0.1});
+    run_for(*a, da, 0.5);
+    run_for(*b, db, 0.5);
+    REQUIRE(da.frozen_spheres() == a->dem.particles().size());
+    REQUIRE(da.frozen_rocks() == 1);
+    add_sphere(a->dem, {0.3, 0.3, 2.0}, {0.0, 0.0, -3.0});
+    add_sphere(b->dem, {0.3, 0.3, 2.0}, {0.0, 0.0, -3.0});
+    std::size_t carried = 0, searched_carried = 0;
+    const std::uint64_t rebuilds = a->dem.rebuild_count();
+    const double end = a->world.time_s() + 0.8;  // it lands after 0.5 s and wakes the corner
+    while (a->world.time_s() < end) {
+        for (CoupledScene* s : {a.get(), b.get()}) s->world.step();
+        da.update(a->world, a->world.coupling_step_s());
+        db.update(b->world, b->world.coupling_step_s());
+        carried = std::max(carried, a->dem.carried_wall_candidates());
+        searched_carried = std::max(searched_carried, b->dem.carried_wall_candidates());
+    }
+    INFO("rebuilds " << a->dem.rebuild_count() - rebuilds << ", at most " << carried << " spheres carried");
+    CHECK(a->dem.rebuild_count() - rebuilds > 10);
+    CHECK(carried > a->dem.particles().size() / 2);  // most of the bed stays frozen
+    CHECK(searched_carried == 0);
+    CHECK(a->dem.particles().position_m == b->dem.particles().position_m);
+    CHECK(a->dem.particles().velocity_m_per_s == b->dem.particles().velocity_m_per_s);
+    CHECK(a->dem.wall_force_N(0) == b->dem.wall_force_N(0));
+    CHECK(a->rigid.state(a->world.rocks()[0].body).position_m == b->rigid.state(b->world.rocks()[0].body).position_m);
+    CHECK(da.frozen_spheres() == db.frozen_spheres());
 }
 
 TEST_CASE("a frozen rock is let go when a sphere comes near, and is pushed", "[coupling][dynamic_domain]")
