@@ -2,7 +2,7 @@
 //
 //   dipper run FILE [--out DIR] [--threads N] [--stop-after S] [--quiet]
 //   dipper check FILE...
-//   dipper resume DIR [--from CHECKPOINT] [--threads N] [--stop-after S] [--quiet]
+//   dipper resume DIR [--from CHECKPOINT] [--threads N] [--stop-after S] [--until S] [--quiet]
 //   dipper sweep FILE [--out DIR] [--threads N] [--quiet]     (under mpirun: variants spread over ranks)
 //   dipper report DIR      (report.md and PNG figures from summary.json and probes.csv)
 //   dipper keys            (every scenario key as a Markdown table)
@@ -36,7 +36,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: dipper run FILE [--out DIR] [--threads N] [--stop-after SECONDS] [--quiet]\n"
     "       dipper check FILE...   (scenario or sweep files)\n"
-    "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--stop-after SECONDS] [--quiet]\n"
+    "       dipper resume DIR [--from CHECKPOINT] [--threads N] [--stop-after SECONDS] [--until SECONDS] [--quiet]\n"
     "       dipper sweep FILE [--out DIR] [--threads N] [--quiet]   (mpirun -np N dipper sweep ... spreads it)\n"
     "       dipper calibrate repose FILE [--target DEG] [--tolerance DEG] [--pair A,B] [--rolling R1,R2,...]\n"
     "                              [--seeds N] [--out DIR] [--threads N] [--quiet]\n"
@@ -72,7 +72,7 @@ const std::map<std::string, std::vector<std::string>>& command_options()
     static const std::map<std::string, std::vector<std::string>> table{
         {"check", {}},
         {"run", {"--out", "--threads", "--stop-after", "--quiet"}},
-        {"resume", {"--from", "--threads", "--stop-after", "--quiet"}},
+        {"resume", {"--from", "--threads", "--stop-after", "--until", "--quiet"}},
         {"sweep", {"--out", "--threads", "--quiet"}},
         {"calibrate", {"--target", "--tolerance", "--pair", "--rolling", "--seeds", "--out", "--threads", "--quiet"}},
         {"report", {}}};
@@ -107,6 +107,8 @@ Options parse_options(int argc, char** argv, int first, const std::string& comma
             char* end = nullptr;
             o.run.stop_after_s = std::strtod(v.c_str(), &end);
             if (v.empty() || *end != '\0' || !(o.run.stop_after_s > 0.0)) usage("--stop-after needs seconds > 0; got '" + v + "'");
+        } else if (arg == "--until") {
+            o.run.until_s = value();
         } else if (arg == "--target") {
             o.repose.target_deg = number_option(arg, value());
         } else if (arg == "--tolerance") {

@@ -210,11 +210,14 @@ std::size_t CoSimulation::add_wear(const std::string& part, const wear::WearLaw&
     }
     w.surface = std::make_unique<wear::WearSurface>(part, std::move(mesh), law, w.wall);
     wear_.push_back(std::move(w));
-    // the spheres' contacts reach the wear surfaces at every DEM step, from inside the DEM's step
-    if (wear_.size() == 1)
-        dem_->set_contact_consumer([this](const std::vector<ContactRecord>& records, double, double dt) {
+    // the spheres' contacts with the wear surfaces reach them at every DEM step, from inside the DEM's step
+    std::vector<int> walls;
+    for (const WearPart& p : wear_) walls.push_back(p.wall);
+    dem_->set_contact_consumer(
+        [this](const std::vector<ContactRecord>& records, double, double dt) {
             for (WearPart& p : wear_) p.surface->accumulate(records, dt);
-        });
+        },
+        walls);
     return wear_.size() - 1;
 }
 
@@ -388,8 +391,8 @@ Vec3 CoSimulation::lip_force_N() const
 {
     if (!has_shovel()) return {};
     Vec3 f;
-    for (const ContactRecord& r : dem_->last_contact_records())
-        if (r.surface_id == dipper_wall_ && r.triangle_id >= 0 && lip_triangle_[static_cast<std::size_t>(r.triangle_id)])
+    for (const ContactRecord& r : dem_->contact_records({dipper_wall_}))
+        if (r.triangle_id >= 0 && lip_triangle_[static_cast<std::size_t>(r.triangle_id)])
             f -= r.normal_world * r.normal_force_N + r.tangential_force_N;  // the records hold the force on the sphere
     Mat3 rotation;
     Vec3 origin;

@@ -201,6 +201,12 @@ Vec3 World::wall_torque_N_m(int wall_id) const
     return wall_torque_N_m_[static_cast<std::size_t>(wall_id)];
 }
 
+void World::set_contact_consumer(ContactConsumer consumer, const std::vector<int>& walls)
+{
+    consumer_walls_ = wall_flags(walls, "set_contact_consumer");
+    consumer_ = std::move(consumer);
+}
+
 void World::set_wall_mass_kg(int wall_id, double mass_kg)
 {
     if (!is_mesh(wall_id)) throw InputError(concat("set_wall_mass_kg: wall '", wall_name(wall_id), "' is a plane, which is immovable"));
@@ -358,7 +364,10 @@ void World::finish_step(double dt_s)
 
     sum_wall_reactions();
 
-    if (consumer_) consumer_(last_contact_records(), time_s_, dt_s);
+    if (consumer_) {
+        records_of(consumer_walls_, consumer_records_);
+        consumer_(consumer_records_, time_s_, dt_s);
+    }
 
     // the first wall contact (in list order) past the overlap limit, found by the wall phase
     std::size_t first = kNoContact, first_convex = kNoContact;

@@ -77,8 +77,9 @@ public:
     bool wall_removed(int wall_id) const;
     /// Mass of the body behind a mesh wall (0: immovable), for the damping's effective mass.
     void set_wall_mass_kg(int wall_id, double mass_kg);
-    /// Receives every sphere-wall contact of each step (see core/contact_record.h).
-    void set_contact_consumer(ContactConsumer consumer) { consumer_ = std::move(consumer); }
+    /// Receives at every step the sphere contacts with the given walls (ids), in last_contact_records' order (see
+    /// core/contact_record.h): a wear surface's own contacts, without a record made for every contact of the step.
+    void set_contact_consumer(ContactConsumer consumer, const std::vector<int>& walls);
 
     // ---- frozen bodies (what coupling::DynamicDomain decides) --------------------------------------
     /// Freezes particle i (dense index) or lets it go. A frozen particle stays where it is, at rest: it is not
@@ -162,6 +163,8 @@ public:
     void prepare();
     /// Surface contacts of the last step.
     const std::vector<ContactRecord>& last_contact_records() const;  ///< built when first asked for
+    /// The last step's surface contacts with the given walls (ids), in last_contact_records' order.
+    std::vector<ContactRecord> contact_records(const std::vector<int>& walls) const;
     std::size_t pair_contact_count() const;          ///< touching sphere pairs in the last step
     std::size_t wall_contact_count() const { return wall_contacts_.size() + convex_contact_count_; }
     std::size_t neighbour_pair_count() const { return pairs_.size(); }
@@ -228,6 +231,8 @@ private:
     std::vector<std::uint8_t> wall_frozen_;   ///< per wall id: 1 while set_wall_frozen holds it
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
+    std::vector<std::uint8_t> consumer_walls_;     ///< per wall id: 1 if the consumer takes its contacts
+    std::vector<ContactRecord> consumer_records_;  ///< this step's records for the consumer
 
     double time_s_ = 0.0, step_s_ = 0.0;
     std::uint64_t step_count_ = 0, rebuild_count_ = 0;
@@ -256,6 +261,10 @@ private:
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
     std::vector<std::vector<Vec3>> thread_wall_force_N_, thread_wall_torque_N_m_;  ///< per thread and wall, this step
     std::vector<std::size_t> thread_first_deep_contact_;  ///< per thread: first wall contact past the overlap limit
+    /// The records of the last step's contacts with the walls flagged in `walls` (per wall id; shorter: the rest
+    /// not taken), into `out`.
+    void records_of(const std::vector<std::uint8_t>& walls, std::vector<ContactRecord>& out) const;
+    std::vector<std::uint8_t> wall_flags(const std::vector<int>& walls, const char* caller) const;
     mutable std::vector<ContactRecord> records_;
     mutable bool records_stale_ = true;
     double max_overlap_ratio_ = 0.0;

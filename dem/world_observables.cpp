@@ -14,6 +14,23 @@ std::size_t World::pair_contact_count() const { return pairs_.contact_count(); }
 
 std::vector<PairContactView> World::pair_contacts() const { return pairs_.contacts(particles_); }
 
+namespace {
+void make_record(const WallContact& c, const ParticleStore& particles, ContactRecord& r)
+{
+    r.point_world = c.point;
+    r.normal_world = c.normal;
+    r.normal_force_N = c.forces.normal_force_N;
+    r.tangential_force_N = c.forces.tangential_force_N;
+    r.relative_displacement_m = c.relative_displacement_m;
+    r.overlap_m = c.overlap_m;
+    r.surface_id = c.wall;
+    r.triangle_id = c.triangle;
+    r.particle_index = static_cast<std::int32_t>(c.particle);
+    r.particle_mass_kg = particles.mass_kg[c.particle];
+    r.first_step = c.first_step;
+}
+}  // namespace
+
 const std::vector<ContactRecord>& World::last_contact_records() const
 {
     if (!records_stale_) return records_;
@@ -24,23 +41,43 @@ const std::vector<ContactRecord>& World::last_contact_records() const
         if (convex_.touching(k)) contacts.push_back(&convex_.contact(k));
     records_.resize(contacts.size());
 #pragma omp parallel for schedule(static) num_threads(threads_)
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-        const WallContact& c = *contacts[k];
-        ContactRecord& r = records_[k];
-        r.point_world = c.point;
-        r.normal_world = c.normal;
-        r.normal_force_N = c.forces.normal_force_N;
-        r.tangential_force_N = c.forces.tangential_force_N;
-        r.relative_displacement_m = c.relative_displacement_m;
-        r.overlap_m = c.overlap_m;
-        r.surface_id = c.wall;
-        r.triangle_id = c.triangle;
-        r.particle_index = static_cast<std::int32_t>(c.particle);
-        r.particle_mass_kg = particles_.mass_kg[c.particle];
-        r.first_step = c.first_step;
-    }
+    for (std::size_t k = 0; k < contacts.size(); ++k) make_record(*contacts[k], particles_, records_[k]);
     records_stale_ = false;
     return records_;
+}
+
+void World::records_of(const std::vector<std::uint8_t>& walls, std::vector<ContactRecord>& out) const
+{
+    // as last_contact_records, those of the flagged walls alone; the convex bodies' pairs are read only if one is
+    // flagged (a wear surface is a machine part, not a rock)
+    const auto taken = [&](std::int32_t wall) { return static_cast<std::size_t>(wall) < walls.size() && walls[static_cast<std::size_t>(wall)]; };
+    out.clear();
+    for (const WallContact& c : wall_contacts_)
+        if (taken(c.wall)) make_record(c, particles_, out.emplace_back());
+    bool convex = false;
+    for (std::size_t w = 0; w < walls.size() && !convex; ++w)
+        convex = walls[w] && walls_[w].is_mesh && meshes_[static_cast<std::size_t>(walls_[w].index)].convex();
+    if (!convex) return;
+    for (std::size_t k = 0; k < convex_.size(); ++k)
+        if (convex_.touching(k) && taken(convex_.contact(k).wall)) make_record(convex_.contact(k), particles_, out.emplace_back());
+}
+
+std::vector<std::uint8_t> World::wall_flags(const std::vector<int>& walls, const char* caller) const
+{
+    std::vector<std::uint8_t> flags(walls_.size(), 0);
+    for (int w : walls) {
+        if (w < 0 || static_cast<std::size_t>(w) >= walls_.size())
+            throw InputError(concat(caller, ": no wall ", w, "; the world has walls 0 to ", static_cast<long>(walls_.size()) - 1));
+        flags[static_cast<std::size_t>(w)] = 1;
+    }
+    return flags;
+}
+
+std::vector<ContactRecord> World::contact_records(const std::vector<int>& walls) const
+{
+    std::vector<ContactRecord> out;
+    records_of(wall_flags(walls, "contact_records"), out);
+    return out;
 }
 
 double World::kinetic_energy_J() const

@@ -8,6 +8,7 @@
 #include "scenario/keys.h"
 #include "scenario/detail/json.h"
 #include "scenario/simulation.h"
+#include "scenario/sweep.h"
 #include "scenario/wear_results.h"
 #include "wear/calibration.h"
 #include "wear/wear_output.h"
@@ -710,6 +711,31 @@ OpenCheckpoint open_checkpoint(const std::string& out_dir, const std::string& ch
     return c;
 }
 
+/// The scenario with time.duration_s moved later to `until` (YAML text of a number), for a resumed run that
+/// should go on past its end; the output folder's scenario.yaml becomes the new text. Only the end moves, so the
+/// run goes on bit for bit as one that had the later end from the start.
+Scenario with_later_end(const Scenario& scenario, const std::string& until, const std::string& out_dir)
+{
+    char* end = nullptr;
+    const double until_s = std::strtod(until.c_str(), &end);
+    if (until.empty() || *end != '\0' || !std::isfinite(until_s))
+        throw InputError(concat("--until needs a time in seconds; got '", until, "'"));
+    if (!(until_s > scenario.duration_s))
+        throw InputError(concat("--until ", until, " s: the run ends at time.duration_s = ", scenario.duration_s,
+                                " s already; give a later time (--stop-after stops a run earlier)"));
+    if (scenario.shovel && scenario.shovel->passes > 0)
+        throw InputError(concat("--until ", until, " s: this run ends after its ", scenario.shovel->passes,
+                                " passes (shovel.passes), not at a time"));
+    const std::string text = concat("# dipper resume --until ", until, ": time.duration_s moved from ", scenario.duration_s,
+                                    " s to ", until, " s (the scenario as it runs on, comments dropped)\n",
+                                    with_values(scenario.text, {{"time.duration_s", until, "--until: "}}, scenario.source));
+    Scenario later = parse_scenario(text, scenario.source, scenario.base_dir);
+    std::ofstream copy = open_for_writing(out_dir + "/scenario.yaml");
+    copy << text;
+    finish_writing(copy, out_dir + "/scenario.yaml");
+    return later;
+}
+
 }  // namespace
 
 RunResult resume_run(const std::string& out_dir, const RunOptions& options, const std::string& checkpoint_file)
@@ -717,6 +743,7 @@ RunResult resume_run(const std::string& out_dir, const RunOptions& options, cons
     OpenCheckpoint c = open_checkpoint(out_dir, checkpoint_file);
     RunOptions o = options;
     if (o.threads <= 0) o.threads = c.threads;  // same thread count, same bits
+    if (!o.until_s.empty()) c.scenario = with_later_end(c.scenario, o.until_s, out_dir);
     Run run(std::move(c.scenario), out_dir, o);
     run.start_from(*c.in);
     return run.loop();

@@ -19,6 +19,9 @@ struct RunOptions {
     int threads = -1;         ///< > 0 replaces the scenario's threads (resume: the checkpoint's count)
     bool progress = true;     ///< progress lines on stderr
     double stop_after_s = 0;  ///< > 0: stop with a checkpoint once simulated time reaches this (tests, batch queues)
+    /// resume only: the run's end (time.duration_s) moved later to this time, as YAML text ("7"); empty keeps it.
+    /// A run that stopped at its end goes on (a pile still creeping); later checkpoints keep the new end.
+    std::string until_s;
     /// Called after every step with the simulated time and the step count; false stops the run with a checkpoint
     /// as SIGINT does (a front end's progress display and stop button).
     std::function<bool(double time_s, std::uint64_t steps)> on_step;

@@ -207,6 +207,52 @@ TEST_CASE("the bound on a moved mesh's vertex travel is never below the true tra
     CHECK(worst_ratio > 0.4);
 }
 
+TEST_CASE("a contact consumer gets the contacts of its walls alone, as the full records list them", "[dem][walls][unit]")
+{
+    // A floor plane, an open plate and a convex box (a rock's kind of wall, whose contacts live apart), a sphere
+    // on each and one between plate and box; the consumer of some walls gets exactly the full records of those
+    // walls, field for field and in the same order, at every step
+    World w = sticky_world();
+    const int floor = w.add_plane({0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, 1, "floor");
+    const int plate = w.add_mesh(meshes::make_plate_mesh(1.0, 1.0, 4, 4), 1, "plate");
+    w.set_mesh_pose(plate, Mat3::identity(), {2.0, 0.0, 0.3}, {}, {}, {});
+    const int box = w.add_mesh(meshes::make_box_mesh({3.0, 0.0, 0.0}, {4.0, 1.0, 0.3}), 1, "box");
+    REQUIRE(w.mesh_wall(box).convex());
+    REQUIRE_FALSE(w.mesh_wall(plate).convex());
+    const double r = 0.1;
+    for (const Vec3& x : {Vec3{0.5, 0.5, r - 1e-4}, Vec3{2.5, 0.5, 0.3 + r - 1e-4}, Vec3{3.5, 0.5, 0.3 + r - 1e-4},
+                          Vec3{3.5, -r + 1e-4, 0.15}})
+        w.add_particle({x, {}, {}, r, 0});
+    const auto same = [](const ContactRecord& a, const ContactRecord& b) {
+        return a.point_world == b.point_world && a.normal_world == b.normal_world && a.normal_force_N == b.normal_force_N &&
+               a.tangential_force_N == b.tangential_force_N && a.relative_displacement_m == b.relative_displacement_m &&
+               a.overlap_m == b.overlap_m && a.surface_id == b.surface_id && a.triangle_id == b.triangle_id &&
+               a.particle_index == b.particle_index && a.particle_mass_kg == b.particle_mass_kg && a.first_step == b.first_step;
+    };
+    for (const std::vector<int>& walls : {std::vector<int>{plate}, std::vector<int>{box}, std::vector<int>{floor, box},
+                                          std::vector<int>{}}) {
+        CAPTURE(walls);
+        std::vector<ContactRecord> seen;
+        w.set_contact_consumer([&](const std::vector<ContactRecord>& records, double, double) { seen = records; }, walls);
+        for (int step = 0; step < 3; ++step) {
+            w.step();
+            std::vector<ContactRecord> expected;
+            for (const ContactRecord& c : w.last_contact_records())
+                if (std::find(walls.begin(), walls.end(), c.surface_id) != walls.end()) expected.push_back(c);
+            CHECK(expected.size() == (walls.empty() ? 0u : walls.size() == 1 && walls[0] == plate ? 1u : walls[0] == box ? 2u : 3u));
+            REQUIRE(seen.size() == expected.size());
+            const std::vector<ContactRecord> asked = w.contact_records(walls);
+            REQUIRE(asked.size() == expected.size());
+            for (std::size_t k = 0; k < expected.size(); ++k) {
+                CHECK(same(seen[k], expected[k]));
+                CHECK(same(asked[k], expected[k]));
+            }
+        }
+    }
+    CHECK_THROWS_WITH(w.set_contact_consumer([](const std::vector<ContactRecord>&, double, double) {}, {7}),
+                      Catch::Contains("set_contact_consumer: no wall 7; the world has walls 0 to 2"));
+}
+
 TEST_CASE("contact records carry force, point and relative displacement of a sliding sphere", "[dem][walls][unit]")
 {
     // A sphere pushed along a mesh floor slides at 1 m/s with mu 0.5 (no rolling: spin locked by a high
@@ -218,7 +264,7 @@ TEST_CASE("contact records carry force, point and relative displacement of a sli
     w.add_particle({{0.5, 1.0, r - 1e-6}, {}, {}, r, 0});
     while (w.time_s() < 0.1) w.step();
     std::vector<ContactRecord> seen;
-    w.set_contact_consumer([&](const std::vector<ContactRecord>& records, double, double) { seen = records; });
+    w.set_contact_consumer([&](const std::vector<ContactRecord>& records, double, double) { seen = records; }, {floor});
     w.particles().velocity_m_per_s[0] = {3.0, 0.0, 0.0};
     w.step();
     REQUIRE(seen.size() == 1);
@@ -477,11 +523,11 @@ TEST_CASE("a sphere whose centre lies inside a convex body is pushed out through
     WorldSettings settings;
     settings.gravity_m_per_s2 = {};
     World w(test::two_material_table(kSticky, 3700.0, 45e9, 0.3), settings);
-    w.add_mesh(meshes::make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}), 1, "box");
+    const int box = w.add_mesh(meshes::make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}), 1, "box");
     const double r = 0.1;
     w.add_particle({{0.99, 0.5, 0.98}, {}, {}, r, 0});
     std::vector<ContactRecord> seen;
-    w.set_contact_consumer([&](const std::vector<ContactRecord>& records, double, double) { seen = records; });
+    w.set_contact_consumer([&](const std::vector<ContactRecord>& records, double, double) { seen = records; }, {box});
     std::string message;
     try {
         w.step();

@@ -319,6 +319,41 @@ TEST_CASE("a run stopped at a checkpoint and resumed ends bit for bit as the uni
     fs::remove_all(base);
 }
 
+TEST_CASE("a run that ended is resumed with a later end (--until) and ends bit for bit as the longer run", "[scenario]")
+{
+    // a pile saved while still creeping is run on to rest: only time.duration_s moves, so the two legs end where
+    // one run with the later end from the start ends, and the later checkpoints carry the new end
+    const fs::path base = fs::temp_directory_path() / "dipper_test_until";
+    fs::remove_all(base);
+    const Scenario longer = parse_scenario(small_scenario(), "small.yaml", ".");
+    REQUIRE(longer.duration_s == 0.3);
+    const Scenario shorter = parse_scenario(std::regex_replace(small_scenario(), std::regex("duration_s: 0.3"), "duration_s: 0.15"),
+                                            "small.yaml", ".");
+    const RunResult whole = run_scenario(longer, (base / "whole").string(), quiet());
+    REQUIRE(whole.status == RunStatus::completed);
+    REQUIRE(run_scenario(shorter, (base / "legs").string(), quiet()).status == RunStatus::completed);
+    CHECK(summary_value((base / "legs").string(), "state_hash") != summary_value((base / "whole").string(), "state_hash"));
+
+    RunOptions later = quiet();
+    later.until_s = "0.1";  // before the end: refused, naming the end
+    CHECK_THROWS_WITH(resume_run((base / "legs").string(), later),
+                      Catch::Contains("--until 0.1 s: the run ends at time.duration_s = 0.15 s already"));
+    later.until_s = "soon";
+    CHECK_THROWS_WITH(resume_run((base / "legs").string(), later), Catch::Contains("--until needs a time in seconds; got 'soon'"));
+    later.until_s = "0.3";
+    const RunResult rest = resume_run((base / "legs").string(), later);
+    REQUIRE(rest.status == RunStatus::completed);
+    CHECK(rest.steps == whole.steps);
+    CHECK(summary_value((base / "legs").string(), "state_hash") == summary_value((base / "whole").string(), "state_hash"));
+    CHECK(read_file((base / "legs" / "scenario.yaml").string()).find("--until 0.3") != std::string::npos);
+    // the checkpoint at the new end holds the new end: a plain resume finds the run ended at 0.3 s
+    const RunResult again = resume_run((base / "legs").string(), quiet());
+    CHECK(again.steps == whole.steps);
+    CHECK_THAT(again.message, Catch::Contains("already ended"));
+    CHECK(summary_value((base / "legs").string(), "duration_s") == "0.3");
+    fs::remove_all(base);
+}
+
 TEST_CASE("resisting each sphere's own spin, a run resumed from a checkpoint ends bit for bit", "[scenario]")
 {
     // the spin resistance is summed anew at each step from the contacts; the torque it adds is in the checkpoint

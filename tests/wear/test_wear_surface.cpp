@@ -154,7 +154,7 @@ TEST_CASE("Archard from the DEM: a sphere sliding into rolling on a meshed plate
     const meshes::TriangleMesh plate = meshes::make_plate_mesh(3.0, 1.0, 24, 8);  // 125 mm cells
     const int floor = w.add_mesh(plate, 1, "plate");
     WearSurface wear("plate", plate, WearLaw::from_name("archard", K, "test"), floor);
-    w.set_contact_consumer([&](const std::vector<ContactRecord>& c, double, double dt) { wear.accumulate(c, dt); });
+    w.set_contact_consumer([&](const std::vector<ContactRecord>& c, double, double dt) { wear.accumulate(c, dt); }, {floor});
     const double m = 4.0 / 3.0 * M_PI * r * r * r * 2500.0;
     w.add_particle({{0.2, 0.5, r}, {}, {}, r, 0});
     while (w.time_s() < 0.1) w.step();  // comes to rest on the plate
@@ -189,7 +189,7 @@ TEST_CASE("DEM records mark each impact once: a bouncing sphere gives one impact
         for (const auto& rec : c)
             if (rec.first_step) speeds.push_back(norm(rec.relative_displacement_m) / dt);
         last_dt = dt;
-    });
+    }, {floor});
     const double h = 0.5, r = 0.05;
     w.add_particle({{0.5, 0.5, r + h}, {}, {}, r, 0});
     while (w.time_s() < 0.5) w.step();  // falls 0.5 m in 0.319 s, lands once, rebounds to ~0.4 m
@@ -223,7 +223,7 @@ TEST_CASE("mesh refinement (30, 45, 60, 75 mm) moves local depth but not total w
             meshes::make_plate_mesh(1.2, 0.6, static_cast<int>(1.2 * cells_per_m), static_cast<int>(0.6 * cells_per_m));
         const int floor = w.add_mesh(plate, 1, "plate");
         WearSurface wear("plate", plate, WearLaw::from_name("force_work", 1e-12, "test"), floor);
-        w.set_contact_consumer([&](const std::vector<ContactRecord>& c, double, double dt) { wear.accumulate(c, dt); });
+        w.set_contact_consumer([&](const std::vector<ContactRecord>& c, double, double dt) { wear.accumulate(c, dt); }, {floor});
         for (int i = 0; i < 8; ++i)  // every other sphere starts faster and runs into the one ahead
             for (int j = 0; j < 5; ++j)
                 w.add_particle({{0.06 + 0.11 * i, 0.06 + 0.11 * j, 0.06 + 0.02 * ((i + j) % 3)},

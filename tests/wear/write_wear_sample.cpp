@@ -31,7 +31,7 @@ int main(int argc, char** argv)
     const auto fill = dem::fill_lattice(w, {0.05, 0.05, 0.2}, {0.6, 0.95, 0.7}, 0.045, 0.1,
                                         w.materials().index_of("ore"), 0.003, 3);
     wear::WearSurface surface("plate", plate, wear::WearLaw::from_name("force_work", 1e-12, "sample"), wall);
-    w.set_contact_consumer([&](const std::vector<ContactRecord>& c, double, double dt) { surface.accumulate(c, dt); });
+    w.set_contact_consumer([&](const std::vector<ContactRecord>& c, double, double dt) { surface.accumulate(c, dt); }, {wall});
     while (w.time_s() < 1.0) w.step();
 
     double mass_kg = 0.0;
