@@ -145,6 +145,29 @@ std::vector<std::string> repose_wall_warnings(const Scenario& s, const dem::Mate
              return v;
          }())
         if (std::find(held.begin(), held.end(), p->material) == held.end()) held.push_back(p->material);
+    // the slice between two side walls facing each other, against the largest particle it holds: the narrowest
+    // slice measured, three diameters, reads the angle of a slice eight times as wide (docs/results.md)
+    double largest_m = 0.0;
+    for (const FillSpec& f : s.fills) {
+        largest_m = std::max(largest_m, 2.0 * f.sizes.max_radius_m());
+        for (const coupling::RockClass& r : f.rocks) largest_m = std::max(largest_m, r.size_m);
+    }
+    for (const PourSpec& q : s.pours) largest_m = std::max(largest_m, 2.0 * q.sizes.max_radius_m());
+    const PlaneSpec *low = nullptr, *high = nullptr;  // the side walls bounding the slice from below and above
+    for (const PlaneSpec& plane : s.planes) {
+        const double n = norm(plane.normal);
+        if (!(std::abs(plane.normal[across]) > 0.99 * n)) continue;
+        if (plane.normal[across] > 0.0 && (!low || plane.point_m[across] > low->point_m[across])) low = &plane;
+        if (plane.normal[across] < 0.0 && (!high || plane.point_m[across] < high->point_m[across])) high = &plane;
+    }
+    if (low && high && largest_m > 0.0) {
+        const double width = high->point_m[across] - low->point_m[across];
+        if (width < 3.0 * largest_m)
+            warnings.push_back(concat("the repose probe's slice between planes '", low->name, "' and '", high->name, "' is ", width,
+                                      " m wide, ", std::round(10.0 * width / largest_m) / 10.0, " times the largest particle (", largest_m,
+                                      " m): narrower than the narrowest slice measured (3 diameters, which read the angle of a slice "
+                                      "8 times as wide; docs/results.md), so its walls may bias the angle; widen it"));
+    }
     for (const PlaneSpec& plane : s.planes) {
         const double n = norm(plane.normal);
         if (!(std::abs(plane.normal[across]) > 0.99 * n)) continue;  // not a side wall of the slope

@@ -118,6 +118,29 @@ TEST_CASE("dipper's repose calibration runs the scenario and writes its table", 
     fs::remove_all(dir);
 }
 
+TEST_CASE("a repose slice narrower than three of its largest particles is warned of", "[scenario][calibrate]")
+{
+    // Measured (docs/results.md): with frictionless walls a slice three sphere diameters wide (0.45 m of 150 mm
+    // spheres) reads the angle of one 24 wide; narrower was not measured. repose.yaml: 0.9 m, six diameters.
+    const std::string dir = DIPPER_SOURCE_DIR "/examples/scenarios";
+    const std::string shipped = test::read_text_file(dir + "/repose.yaml");
+    const auto warnings_at = [&](const std::string& y) {
+        const std::string narrowed = std::regex_replace(shipped, std::regex("point_m: \\[0, 0.9, 0\\]"), "point_m: [0, " + y + ", 0]");
+        REQUIRE(narrowed != shipped);
+        return check_scenario(parse_scenario(narrowed, "narrow.yaml", dir));
+    };
+    CHECK(warnings_at("0.45").empty());  // three diameters: the narrowest measured
+    const std::vector<std::string> w = warnings_at("0.4");
+    REQUIRE(w.size() == 1);
+    CHECK_THAT(w[0], Catch::Contains("between planes 'side_a' and 'side_b' is 0.4 m wide") &&
+                         Catch::Contains("the largest particle (0.15 m)") && Catch::Contains("widen it"));
+    // a mix counts its largest rock: repose_mix.yaml's 2.4 m slice holds rocks of 850 mm (2.8 of them)
+    const std::string mix = test::read_text_file(dir + "/repose_mix.yaml");
+    const std::vector<std::string> wm = check_scenario(parse_scenario(mix, "repose_mix.yaml", dir));
+    REQUIRE(wm.size() == 1);
+    CHECK_THAT(wm[0], Catch::Contains("is 2.4 m wide") && Catch::Contains("(0.85 m)"));
+}
+
 TEST_CASE("a repose slice between side walls with friction is warned of but not one between frictionless walls",
           "[scenario][calibrate]")
 {
