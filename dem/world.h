@@ -231,7 +231,12 @@ private:
     std::vector<std::uint8_t> wall_frozen_;   ///< per wall id: 1 while set_wall_frozen holds it
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
-    std::vector<std::uint8_t> consumer_walls_;     ///< per wall id: 1 if the consumer takes its contacts
+    /// Walls whose contacts are asked for: a flag per wall id (walls added later are not), and whether one is convex.
+    struct WallFlags {
+        std::vector<std::uint8_t> flag;
+        bool any_convex = false;
+    };
+    WallFlags consumer_walls_;                     ///< the walls whose contacts the consumer takes
     std::vector<ContactRecord> consumer_records_;  ///< this step's records for the consumer
 
     double time_s_ = 0.0, step_s_ = 0.0;
@@ -261,10 +266,9 @@ private:
     std::vector<Vec3> wall_force_N_, wall_torque_N_m_;
     std::vector<std::vector<Vec3>> thread_wall_force_N_, thread_wall_torque_N_m_;  ///< per thread and wall, this step
     std::vector<std::size_t> thread_first_deep_contact_;  ///< per thread: first wall contact past the overlap limit
-    /// The records of the last step's contacts with the walls flagged in `walls` (per wall id; shorter: the rest
-    /// not taken), into `out`.
-    void records_of(const std::vector<std::uint8_t>& walls, std::vector<ContactRecord>& out) const;
-    std::vector<std::uint8_t> wall_flags(const std::vector<int>& walls, const char* caller) const;
+    /// The records of the last step's contacts with the flagged walls, into `out`.
+    void records_of(const WallFlags& walls, std::vector<ContactRecord>& out) const;
+    WallFlags wall_flags(const std::vector<int>& walls, const char* caller) const;
     mutable std::vector<ContactRecord> records_;
     mutable bool records_stale_ = true;
     double max_overlap_ratio_ = 0.0;

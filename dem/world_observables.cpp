@@ -46,29 +46,31 @@ const std::vector<ContactRecord>& World::last_contact_records() const
     return records_;
 }
 
-void World::records_of(const std::vector<std::uint8_t>& walls, std::vector<ContactRecord>& out) const
+void World::records_of(const WallFlags& walls, std::vector<ContactRecord>& out) const
 {
     // as last_contact_records, those of the flagged walls alone; the convex bodies' pairs are read only if one is
     // flagged (a wear surface is a machine part, not a rock)
-    const auto taken = [&](std::int32_t wall) { return static_cast<std::size_t>(wall) < walls.size() && walls[static_cast<std::size_t>(wall)]; };
+    const auto taken = [&](std::int32_t wall) {
+        return static_cast<std::size_t>(wall) < walls.flag.size() && walls.flag[static_cast<std::size_t>(wall)];
+    };
     out.clear();
     for (const WallContact& c : wall_contacts_)
         if (taken(c.wall)) make_record(c, particles_, out.emplace_back());
-    bool convex = false;
-    for (std::size_t w = 0; w < walls.size() && !convex; ++w)
-        convex = walls[w] && walls_[w].is_mesh && meshes_[static_cast<std::size_t>(walls_[w].index)].convex();
-    if (!convex) return;
+    if (!walls.any_convex) return;
     for (std::size_t k = 0; k < convex_.size(); ++k)
         if (convex_.touching(k) && taken(convex_.contact(k).wall)) make_record(convex_.contact(k), particles_, out.emplace_back());
 }
 
-std::vector<std::uint8_t> World::wall_flags(const std::vector<int>& walls, const char* caller) const
+World::WallFlags World::wall_flags(const std::vector<int>& walls, const char* caller) const
 {
-    std::vector<std::uint8_t> flags(walls_.size(), 0);
+    WallFlags flags;
+    flags.flag.assign(walls_.size(), 0);
     for (int w : walls) {
         if (w < 0 || static_cast<std::size_t>(w) >= walls_.size())
             throw InputError(concat(caller, ": no wall ", w, "; the world has walls 0 to ", static_cast<long>(walls_.size()) - 1));
-        flags[static_cast<std::size_t>(w)] = 1;
+        const WallRef& ref = walls_[static_cast<std::size_t>(w)];
+        flags.flag[static_cast<std::size_t>(w)] = 1;
+        flags.any_convex = flags.any_convex || (ref.is_mesh && meshes_[static_cast<std::size_t>(ref.index)].convex());
     }
     return flags;
 }
