@@ -20,8 +20,36 @@ DynamicDomain::DynamicDomain(DynamicDomainSettings settings) : settings_(setting
 {
     require_positive(settings_.margin_m, "margin_m", "dynamic domain");
     require_positive(settings_.rest_speed_m_per_s, "rest_speed_m_per_s", "dynamic domain");
-    if (!(settings_.rest_time_s >= 0.0) || !std::isfinite(settings_.rest_time_s))
-        throw InputError(concat("dynamic domain: rest_time_s is ", settings_.rest_time_s, "; expected a finite value >= 0"));
+    require_positive(settings_.rest_time_s, "rest_time_s", "dynamic domain");
+}
+
+DynamicDomain::Motion DynamicDomain::advance(Rest& rest, const Vec3& x, double interval_s) const
+{
+    const double reach = settings_.rest_speed_m_per_s * settings_.rest_time_s;
+    const double step = kMovingFactor * settings_.rest_speed_m_per_s * interval_s;
+    // a new body (its last place nowhere) is judged from its second update on
+    const bool moving = rest.last_m.x != kNowhere && norm_squared(x - rest.last_m) > step * step;
+    rest.last_m = x;
+    if (norm_squared(x - rest.anchor_m) > reach * reach) {
+        rest.anchor_m = x;
+        rest.time_s = 0.0;
+    } else {
+        rest.time_s += interval_s;
+    }
+    // what moved fast keeps moving (and its surroundings awake) until it comes to rest: a sphere that hits a body
+    // and stops short must not leave it to freeze with the blow in it
+    if (moving)
+        rest.motion = Motion::moving;
+    else if (rest.time_s >= settings_.rest_time_s)
+        rest.motion = Motion::resting;
+    else if (rest.motion != Motion::moving)
+        rest.motion = Motion::creeping;
+    return rest.motion;
+}
+
+bool DynamicDomain::sphere_moving(std::uint32_t id) const
+{
+    return id >= sphere_rest_.size() || sphere_rest_[id].motion == Motion::moving;
 }
 
 std::size_t DynamicDomain::cell_index(const Vec3& p) const
@@ -69,25 +97,30 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     const dem::ParticleStore& p = dem.particles();
     const std::size_t n = p.size();
     const std::vector<RockRecord>& rocks = coupled.rocks();
-    const double rest_speed = settings_.rest_speed_m_per_s;
+    if (n == 0 && rocks.empty()) return;
 
-    // each rock's DEM wall, bounding sphere and speed
+    // 1. what each body did: rested (stayed near its anchor for rest_time_s), crept, or moved
+    std::uint32_t max_id = 0;
+    for (std::uint32_t id : p.id) max_id = std::max(max_id, id);
+    if (n > 0 && sphere_rest_.size() <= max_id) sphere_rest_.resize(static_cast<std::size_t>(max_id) + 1);
+    std::vector<Motion> sphere_motion(n);
+    for (std::size_t i = 0; i < n; ++i) sphere_motion[i] = advance(sphere_rest_[p.id[i]], p.position_m[i], interval_s);
     struct RockNow {
         int wall;
         Vec3 centre;
-        double radius, speed;
+        double radius;
+        Motion motion;
     };
+    rock_rest_.resize(rocks.size());
     std::vector<RockNow> rock_now(rocks.size());
     for (std::size_t k = 0; k < rocks.size(); ++k) {
         const int wall = coupled.body(coupled.index_of(rocks[k].body)).wall;
         const dem::MeshWall& m = dem.mesh_wall(wall);
-        const rigid::BodyState s = rigid.state(rocks[k].body);
-        rock_now[k] = {wall, m.bound_centre_world_m(), m.bound_radius_m(),
-                       norm(s.velocity_m_per_s) + norm(s.angular_velocity_rad_per_s) * m.bound_radius_m()};
+        const Vec3 centre = m.bound_centre_world_m();
+        rock_now[k] = {wall, centre, m.bound_radius_m(), advance(rock_rest_[k], centre, interval_s)};
     }
-    if (n == 0 && rocks.empty()) return;
 
-    // 1. the grid over every body, cells margin_m wide
+    // 2. the grid over every body, cells margin_m wide
     const double inf = std::numeric_limits<double>::infinity();
     Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
     auto grow = [&](const Vec3& a, const Vec3& b) {
@@ -108,15 +141,12 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
     hot_.assign(cells, 0);
 
-    // 2. the cells with something moving: spheres and rocks faster than the rest speed, walls that move or may move
-    //    (a machine part, a gate) over their bounding sphere
-    auto sphere_speed = [&](std::size_t i) {
-        return norm(p.velocity_m_per_s[i]) + norm(p.angular_velocity_rad_per_s[i]) * p.radius_m[i];
-    };
+    // 3. the cells with something moving: spheres and rocks that moved, walls that move or may move (a machine
+    //    part, a gate) over their bounding sphere
     for (std::size_t i = 0; i < n; ++i)
-        if (!p.frozen[i] && sphere_speed(i) > rest_speed) hot_[cell_index(p.position_m[i])] = 1;
+        if (sphere_motion[i] == Motion::moving) hot_[cell_index(p.position_m[i])] = 1;
     for (const RockNow& r : rock_now)
-        if (r.speed > rest_speed) mark(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
+        if (r.motion == Motion::moving) mark(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
     for (std::size_t w = 0; w < dem.wall_count(); ++w) {
         const int wall = static_cast<int>(w);
         if (!dem.is_mesh(wall) || dem.wall_removed(wall)) continue;
@@ -131,7 +161,7 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
         mark(c - Vec3{r, r, r}, c + Vec3{r, r, r});
     }
 
-    // 3. near: a hot cell and the 26 around it
+    // 4. near: a hot cell and the 26 around it
     near_.assign(cells, 0);
     for (int z = 0; z < dims_[2]; ++z)
         for (int y = 0; y < dims_[1]; ++y)
@@ -143,26 +173,17 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
                             near_[(static_cast<std::size_t>(zz) * dims_[1] + yy) * dims_[0] + xx] = 1;
             }
 
-    // 4. each body's time at rest; frozen once at rest for rest_time_s and not near anything moving, let go when
-    //    something moving comes near
-    std::uint32_t max_id = 0;
-    for (std::uint32_t id : p.id) max_id = std::max(max_id, id);
-    if (n > 0 && sphere_rest_s_.size() <= max_id) sphere_rest_s_.resize(static_cast<std::size_t>(max_id) + 1, 0.0);
+    // 5. frozen when at rest and not near anything moving, let go when something moving comes near
     frozen_spheres_ = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        double& rest = sphere_rest_s_[p.id[i]];
-        rest = sphere_speed(i) <= rest_speed ? rest + interval_s : 0.0;
-        const bool freeze = rest >= settings_.rest_time_s && !near_[cell_index(p.position_m[i])];
+        const bool freeze = sphere_motion[i] == Motion::resting && !near_[cell_index(p.position_m[i])];
         if (freeze != (p.frozen[i] != 0)) dem.set_frozen(i, freeze);
         frozen_spheres_ += freeze ? 1 : 0;
     }
-    rock_rest_s_.resize(rocks.size(), 0.0);
     frozen_rocks_ = 0;
     for (std::size_t k = 0; k < rocks.size(); ++k) {
         const RockNow& r = rock_now[k];
-        double& rest = rock_rest_s_[k];
-        rest = r.speed <= rest_speed ? rest + interval_s : 0.0;
-        const bool freeze = rest >= settings_.rest_time_s &&
+        const bool freeze = r.motion == Motion::resting &&
                             !near(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
         if (freeze != rigid.frozen(rocks[k].body)) {
             rigid.set_frozen(rocks[k].body, freeze);
@@ -176,7 +197,7 @@ template <class IO, class Self>
 void DynamicDomain::state_fields(IO& io, Self& s)
 {
     io.tag("dynamic-domain");
-    io(s.sphere_rest_s_, s.rock_rest_s_, s.frozen_spheres_, s.frozen_rocks_);
+    io(s.sphere_rest_, s.rock_rest_, s.frozen_spheres_, s.frozen_rocks_);
 }
 
 void DynamicDomain::write_state(StateWriter& out) const { state_fields(out, *this); }
@@ -184,9 +205,16 @@ void DynamicDomain::write_state(StateWriter& out) const { state_fields(out, *thi
 void DynamicDomain::read_state(StateReader& in)
 {
     state_fields(in, *this);
-    for (const auto* v : {&sphere_rest_s_, &rock_rest_s_})
-        for (double t : *v)
-            if (!(t >= 0.0) || !std::isfinite(t)) in.fail(concat("a time at rest of ", t, " s; expected a finite value >= 0"));
+    for (const auto* v : {&sphere_rest_, &rock_rest_})
+        for (const Rest& r : *v) {
+            if (!(r.time_s >= 0.0) || !std::isfinite(r.time_s))
+                in.fail(concat("a time at rest of ", r.time_s, " s; expected a finite value >= 0"));
+            for (const Vec3& x : {r.anchor_m, r.last_m})
+                if (!(std::abs(x.x) <= kNowhere && std::abs(x.y) <= kNowhere && std::abs(x.z) <= kNowhere))
+                    in.fail(concat("a body's place at rest at (", x.x, ", ", x.y, ", ", x.z, ") m; expected finite coordinates"));
+            if (static_cast<int>(r.motion) > static_cast<int>(Motion::moving))
+                in.fail(concat("a body's motion ", static_cast<int>(r.motion), "; expected 0, 1 or 2"));
+        }
 }
 
 }  // namespace dipper::coupling

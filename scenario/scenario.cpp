@@ -412,7 +412,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         if (!(dd.margin_m > 0.0) || dd.margin_m > 1e3) d.fail("margin_m", concat(dd.margin_m), "a distance > 0 and at most 1000 m");
         if (!(dd.rest_speed_m_per_s > 0.0) || dd.rest_speed_m_per_s > 1e3)
             d.fail("rest_speed_m_per_s", concat(dd.rest_speed_m_per_s), "a speed > 0 and at most 1000 m/s");
-        if (!(dd.rest_time_s >= 0.0) || dd.rest_time_s > 1e6) d.fail("rest_time_s", concat(dd.rest_time_s), "a time >= 0 and at most 10^6 s");
+        if (!(dd.rest_time_s > 0.0) || dd.rest_time_s > 1e6) d.fail("rest_time_s", concat(dd.rest_time_s), "a time > 0 and at most 10^6 s");
     }
     if (top.has("shovel")) s.shovel = read_shovel(s, top.map("shovel"));
     for (const MapReader& w : top.maps("wear")) {

@@ -366,5 +366,7 @@ output: {vtk_interval_s: 0, csv_interval_s: 0.05, pile_file: pile.txt}
                Contains("dynamic_domain: it freezes bodies of the co-simulation"));
     CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex("margin_m: 0.3"), "margin_m: -1")),
                Contains("dynamic_domain.margin_m"));
+    CHECK_THAT(test::scenario_error(std::regex_replace(text, std::regex("rest_time_s: 0.1"), "rest_time_s: 0")),
+               Contains("dynamic_domain.rest_time_s") && Contains("a time > 0"));
     fs::remove_all(dir);
 }
