@@ -26,9 +26,10 @@ DynamicDomain::DynamicDomain(DynamicDomainSettings settings) : settings_(setting
 DynamicDomain::Motion DynamicDomain::advance(Rest& rest, const Vec3& x, double interval_s) const
 {
     const double reach = settings_.rest_speed_m_per_s * settings_.rest_time_s;
-    const double step = kMovingFactor * settings_.rest_speed_m_per_s * interval_s;
+    const double slow = settings_.rest_speed_m_per_s * interval_s;  // the last step at most at the rest speed
+    const double fast = kMovingFactor * slow;
     // a new body (its last place nowhere) is judged from its second update on
-    const bool moving = rest.last_m.x != kNowhere && norm_squared(x - rest.last_m) > step * step;
+    const double step2 = rest.last_m.x == kNowhere ? 0.0 : norm_squared(x - rest.last_m);
     rest.last_m = x;
     if (norm_squared(x - rest.anchor_m) > reach * reach) {
         rest.anchor_m = x;
@@ -36,13 +37,13 @@ DynamicDomain::Motion DynamicDomain::advance(Rest& rest, const Vec3& x, double i
     } else {
         rest.time_s += interval_s;
     }
-    // what moved fast keeps moving (and its surroundings awake) until it comes to rest: a sphere that hits a body
-    // and stops short must not leave it to freeze with the blow in it
-    if (moving)
+    // at rest: near its anchor long enough, and not set going in the last step (a body just struck is still within
+    // reach of its anchor for a while, and must not freeze with the blow in it)
+    if (step2 > fast * fast)
         rest.motion = Motion::moving;
-    else if (rest.time_s >= settings_.rest_time_s)
+    else if (rest.time_s >= settings_.rest_time_s && step2 <= slow * slow)
         rest.motion = Motion::resting;
-    else if (rest.motion != Motion::moving)
+    else
         rest.motion = Motion::creeping;
     return rest.motion;
 }

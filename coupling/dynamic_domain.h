@@ -1,9 +1,9 @@
 // Only what moves: spheres and rocks at rest, away from the machine and from moving material, are frozen (held
 // still, out of the integration and of the contacts between frozen bodies) and let go when something moving
 // comes within a margin. At rest means going nowhere: a body that stays within rest_speed x rest_time of one point
-// for rest_time, however it jitters there. Moving means going somewhere fast: more than ten times the rest speed
-// over a coupling step, and not at rest since. What lies between (a slow creep) neither freezes nor keeps others
-// from freezing. The thesis' simplified model held its resting particles fixed by hand; EDEM calls the
+// for rest_time, however it jitters there, and went no faster than the rest speed over the last coupling step.
+// Moving means going somewhere fast: more than ten times the rest speed over the last coupling step. What lies
+// between (a slow creep) neither freezes nor keeps others from freezing. The thesis' simplified model held its resting particles fixed by hand; EDEM calls the
 // same a dynamic domain.
 #pragma once
 
@@ -22,11 +22,12 @@ class CoupledWorld;
 struct DynamicDomainSettings {
     bool enabled = false;
     /// A body is frozen only if nothing moving (a sphere or rock that moved faster than kMovingFactor x rest_speed
-    /// over a coupling step and has not come to rest since, a moving wall's bounding sphere) lies in its cell of
-    /// this size or the 26 around it: at least this far from it.
+    /// over the last coupling step, a moving wall's bounding sphere) lies in its cell of this size or the 26 around
+    /// it: at least this far from it.
     double margin_m = 1.0;
-    /// At rest: the centre (a rock's bounding centre) has stayed within rest_speed x rest_time of where it was
-    /// rest_time ago and since: on average no faster than this, whatever its speed of the moment.
+    /// At rest: the centre (a rock's bounding centre) has stayed within rest_speed x rest_time of one point for
+    /// rest_time (on average no faster than this, whatever its speed of the moment) and went no faster than this
+    /// over the last coupling step.
     double rest_speed_m_per_s = 0.01;
     /// ... over at least this long.
     double rest_time_s = 0.2;
@@ -78,7 +79,7 @@ private:
     struct Rest {
         Vec3 anchor_m{kNowhere, kNowhere, kNowhere};
         Vec3 last_m{kNowhere, kNowhere, kNowhere};  ///< where it was at the last update
-        double time_s = 0.0;
+        double time_s = 0.0;  ///< how long it has stayed within reach of its anchor
         Motion motion = Motion::creeping;
     };
     /// The body now at x, after interval_s: its rest moved on and what it did.
