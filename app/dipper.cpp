@@ -215,22 +215,37 @@ int sweep(const Options& o)
 #endif
     const std::size_t n = sw.variants().size();
     if (rank == 0) std::printf("dipper sweep: %zu variants into %s on %d process%s\n", n, dir.c_str(), ranks, ranks == 1 ? "" : "es");
-    int failed = 0;
+    int failed = 0, stopped = 0;
     std::string error;
     try {
-        failed = run_sweep_variants(sw, dir, o.run, rank, ranks);
+        const SweepOutcome outcome = run_sweep_variants(sw, dir, o.run, rank, ranks);
+        failed = outcome.failed;
+        stopped = outcome.stopped ? 1 : 0;
     } catch (const std::exception& e) {
         error = e.what();
         failed = 1;
     }
 #ifdef DIPPER_HAVE_MPI
     if (under_mpi) {
-        int total = 0;
+        int total = 0, any_stopped = 0;
         MPI_Allreduce(&failed, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+        MPI_Allreduce(&stopped, &any_stopped, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
         failed = total;
+        stopped = any_stopped;
     }
 #endif
     if (!error.empty()) std::fprintf(stderr, "dipper: rank %d: %s\n", rank, error.c_str());
+    if (stopped != 0) {
+        if (rank == 0)
+            std::printf("dipper sweep: stopped by a signal; the variants run so far are in %s (an interrupted one "
+                        "continues with dipper resume %s/variant_NNN), the others were not started, and no table was "
+                        "written\n",
+                        dir.c_str(), dir.c_str());
+#ifdef DIPPER_HAVE_MPI
+        if (under_mpi) MPI_Finalize();
+#endif
+        return 130;
+    }
     if (rank == 0 && error.empty()) {
         write_sweep_table(sw, dir);
         make_report(dir);

@@ -238,6 +238,7 @@ public:
                 if (g_signal != 0 || caller_stops || (options_.stop_after_s > 0.0 && reached(options_.stop_after_s) && !reached(end_s))) {
                     checkpoint();
                     result.status = RunStatus::interrupted;
+                    result.stopped_by_signal = g_signal != 0;
                     result.message = g_signal != 0 ? concat("stopped by signal ", static_cast<int>(g_signal))
                                      : caller_stops ? concat("stopped by the caller at t = ", world_->time_s(), " s")
                                                     : concat("stopped at t = ", world_->time_s(), " s as asked");

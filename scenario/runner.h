@@ -32,6 +32,7 @@ struct RunResult {
     std::string message;      ///< the diagnosis of a diverged run
     double time_s = 0.0;
     std::uint64_t steps = 0;
+    bool stopped_by_signal = false;  ///< interrupted by SIGINT or SIGTERM: a sweep stops with it
 };
 
 /// Runs a scenario from t = 0, writing into out_dir (created; files of an earlier run there are replaced).

@@ -243,15 +243,20 @@ std::string variant_dir(const std::string& out_dir, std::size_t v)
 }
 }  // namespace
 
-int run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const RunOptions& options, int rank, int ranks)
+SweepOutcome run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const RunOptions& options, int rank, int ranks)
 {
-    int failed = 0;
+    SweepOutcome outcome;
+    int& failed = outcome.failed;
     const std::size_t n = sweep.variants().size();
     for (std::size_t v = 0; v < n; ++v) {
         if (static_cast<int>(v % static_cast<std::size_t>(ranks)) != rank) continue;
         try {
             const RunResult r = run_scenario(sweep.variant_scenario(v), variant_dir(out_dir, v), options);
             if (r.status != RunStatus::completed) ++failed;
+            if (r.stopped_by_signal) {  // the user stops the sweep, not one variant of it
+                outcome.stopped = true;
+                return outcome;
+            }
         } catch (const InputError& e) {
             // a variant refused as it starts (a pour that places nothing, too little memory) stops only itself:
             // its summary says why, and the others run on
@@ -270,7 +275,7 @@ int run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const Run
             finish_writing(out, path);
         }
     }
-    return failed;
+    return outcome;
 }
 
 namespace {

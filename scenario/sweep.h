@@ -47,9 +47,14 @@ struct Sweep {
 /// Every variant is parsed here, so a bad key or value fails before anything runs.
 Sweep load_sweep(const std::string& path);
 
-/// Runs the variants whose index % ranks == rank into out_dir/variant_NNN (all of them for 1 rank).
-/// Returns how many of those did not complete.
-int run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const RunOptions& options, int rank, int ranks);
+/// What a rank's share of a sweep came to.
+struct SweepOutcome {
+    int failed = 0;        ///< variants that did not complete
+    bool stopped = false;  ///< a variant was stopped by SIGINT or SIGTERM, and the ones after it were not started
+};
+/// Runs the variants whose index % ranks == rank into out_dir/variant_NNN (all of them for 1 rank), until one is
+/// stopped by a signal.
+SweepOutcome run_sweep_variants(const Sweep& sweep, const std::string& out_dir, const RunOptions& options, int rank, int ranks);
 
 /// Writes out_dir/sweep.csv from the variants' summary.json files: variant, parameter values, status,
 /// time, steps, particles, mass, kinetic energy, region masses, wall forces. No wall-clock columns, so

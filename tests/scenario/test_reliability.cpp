@@ -199,7 +199,7 @@ TEST_CASE("a sweep refuses a key swept twice, and a variant refused at its start
     const Sweep sweep = load_sweep((dir / "sweep.yaml").string());
     RunOptions quiet;
     quiet.progress = false;
-    CHECK(run_sweep_variants(sweep, (dir / "out").string(), quiet, 0, 1) == 1);
+    CHECK(run_sweep_variants(sweep, (dir / "out").string(), quiet, 0, 1).failed == 1);
     write_sweep_table(sweep, (dir / "out").string());
     const std::string table = test::read_text_file((dir / "out" / "sweep.csv").string());
     CHECK_THAT(table, Contains("\n0,\"[0.21, 0.21, 4.0]\",refused,") && Contains("\n1,\"[2.5, 2.5, 4.0]\",completed,"));
