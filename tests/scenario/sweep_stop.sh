@@ -6,17 +6,10 @@
 set -euo pipefail
 dipper=$1 sweep=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
+. "$(dirname "$0")/interrupt.sh"
 
 "$dipper" sweep "$sweep" --out "$work/out" --quiet > "$work/log" 2>&1 &
-pid=$!
-for _ in $(seq 1 1200); do
-  [ -f "$work/out/variant_000/checkpoint.bin" ] && break
-  sleep 0.02
-done
-kill -INT "$pid" 2> /dev/null || { echo "FAIL: the sweep ended before SIGINT"; exit 1; }
-rc=0
-wait "$pid" || rc=$?
-[ "$rc" = 130 ] || { echo "FAIL: the sweep exited $rc after SIGINT, expected 130"; cat "$work/log"; exit 1; }
+interrupt_when $! "$work/out/variant_000/checkpoint.bin"
 status=$(sed -n 's/.*"status": "\([a-z]*\)".*/\1/p' "$work/out/variant_000/summary.json")
 [ "$status" = interrupted ] || { echo "FAIL: the first variant's status is '$status', expected interrupted"; exit 1; }
 [ -f "$work/out/variant_000/checkpoint.bin" ] || { echo "FAIL: the interrupted variant lost its checkpoint"; exit 1; }
