@@ -3,8 +3,8 @@
 // comes within a margin. At rest means going nowhere: a body that stays within rest_speed x rest_time of one point
 // for rest_time, however it jitters there, and went no faster than the rest speed over the last coupling step.
 // Moving means going somewhere fast: more than ten times the rest speed over the last coupling step. What lies
-// between (a slow creep) neither freezes nor keeps others from freezing. The thesis' simplified model held its resting particles fixed by hand; EDEM calls the
-// same a dynamic domain.
+// between (a slow creep) neither freezes nor keeps others from freezing. The thesis' simplified model held its
+// resting particles fixed by hand; EDEM calls the same a dynamic domain.
 #pragma once
 
 #include "core/state_io.h"
