@@ -153,6 +153,27 @@ TEST_CASE("at rest is going nowhere: a slow drift freezes, a creep neither freez
     CHECK_FALSE(p.frozen[at(creep)]);
 }
 
+TEST_CASE("a body set going near its resting point does not freeze with the push in it", "[coupling][dynamic_domain]")
+{
+    // A sphere in free space sits still for 0.17 s, then is pushed at 0.05 m/s: it stays within the 2 mm reach of
+    // its resting point until 0.21 s, so its time there passes the 0.2 s rest time while it moves five times faster
+    // than the rest speed at every coupling step. It must not freeze then (frozen, it would lose the push for good);
+    // it creeps, and is not moving either (below 0.1 m/s).
+    auto s = make_scene(5, {0.0, 0.0, 0.0});
+    const std::uint32_t id = add_sphere(s->dem, {0.0, 0.0, 0.0});
+    dem::ParticleStore& p = s->dem.particles();
+    auto at = [&](std::uint32_t k) { return static_cast<std::size_t>(std::find(p.id.begin(), p.id.end(), k) - p.id.begin()); };
+    coupling::DynamicDomain d({true, 0.5, 0.01, 0.2});
+    run_for(*s, d, 0.17);
+    REQUIRE_FALSE(p.frozen[at(id)]);
+    p.velocity_m_per_s[at(id)] = {0.05, 0.0, 0.0};
+    run_for(*s, d, 0.035);  // to about 0.205 s: past the rest time, 1.75 mm from the resting point
+    REQUIRE(std::abs(p.position_m[at(id)].x) < 0.002);
+    CHECK_FALSE(p.frozen[at(id)]);
+    CHECK_FALSE(d.sphere_moving(id));
+    CHECK(p.velocity_m_per_s[at(id)].x == Approx(0.05).epsilon(1e-12));
+}
+
 TEST_CASE("a frozen bed's walls carried over at a rebuild give the bits of a search", "[coupling][dynamic_domain]")
 {
     // The same bed twice, one searching every sphere's walls at every rebuild: frozen with its rock, then hit at one
