@@ -26,22 +26,35 @@ DynamicDomain::DynamicDomain(DynamicDomainSettings settings) : settings_(setting
 DynamicDomain::Motion DynamicDomain::advance(Rest& rest, const Vec3& x, double interval_s) const
 {
     const double reach = settings_.rest_speed_m_per_s * settings_.rest_time_s;
-    const double slow = settings_.rest_speed_m_per_s * interval_s;  // the last step at most at the rest speed
-    const double fast = kMovingFactor * slow;
-    // a new body (its last place nowhere) is judged from its second update on
-    const double step2 = rest.last_m.x == kNowhere ? 0.0 : norm_squared(x - rest.last_m);
-    rest.last_m = x;
+    const double window = settings_.rest_time_s / kWindowsPerRestTime;
+    // the two windows: a new body starts its newer one where it is and is judged once it has an older one
+    rest.older_s += interval_s;
+    rest.newer_s += interval_s;
+    if (rest.newer_m.x == kNowhere) {
+        rest.newer_m = x;
+        rest.newer_s = 0.0;
+    } else if (rest.newer_s >= window) {
+        rest.older_m = rest.newer_m;
+        rest.older_s = rest.newer_s;
+        rest.newer_m = x;
+        rest.newer_s = 0.0;
+    }
     if (norm_squared(x - rest.anchor_m) > reach * reach) {
         rest.anchor_m = x;
         rest.time_s = 0.0;
     } else {
         rest.time_s += interval_s;
     }
-    // at rest: near its anchor long enough, and not set going in the last step (a body just struck is still within
-    // reach of its anchor for a while, and must not freeze with the blow in it)
-    if (step2 > fast * fast)
+    if (rest.older_m.x == kNowhere) return rest.motion = Motion::creeping;
+    // its mean speed over the windows, squared and times the time squared
+    const double moved2 = norm_squared(x - rest.older_m);
+    const double slow = settings_.rest_speed_m_per_s * rest.older_s;
+    const double fast = kMovingFactor * slow;
+    // at rest: near its anchor long enough, and not set going of late (a body just struck is still within reach of
+    // its anchor for a while, and must not freeze with the blow in it)
+    if (moved2 > fast * fast)
         rest.motion = Motion::moving;
-    else if (rest.time_s >= settings_.rest_time_s && step2 <= slow * slow)
+    else if (rest.time_s >= settings_.rest_time_s && moved2 <= slow * slow)
         rest.motion = Motion::resting;
     else
         rest.motion = Motion::creeping;
@@ -119,6 +132,16 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
         const dem::MeshWall& m = dem.mesh_wall(wall);
         const Vec3 centre = m.bound_centre_world_m();
         rock_now[k] = {wall, centre, m.bound_radius_m(), advance(rock_rest_[k], centre, interval_s)};
+    }
+
+    resting_bodies_ = moving_bodies_ = 0;
+    for (Motion m : sphere_motion) {
+        resting_bodies_ += m == Motion::resting ? 1 : 0;
+        moving_bodies_ += m == Motion::moving ? 1 : 0;
+    }
+    for (const RockNow& r : rock_now) {
+        resting_bodies_ += r.motion == Motion::resting ? 1 : 0;
+        moving_bodies_ += r.motion == Motion::moving ? 1 : 0;
     }
 
     // 2. the grid over every body, cells margin_m wide
@@ -208,9 +231,9 @@ void DynamicDomain::read_state(StateReader& in)
     state_fields(in, *this);
     for (const auto* v : {&sphere_rest_, &rock_rest_})
         for (const Rest& r : *v) {
-            if (!(r.time_s >= 0.0) || !std::isfinite(r.time_s))
-                in.fail(concat("a time at rest of ", r.time_s, " s; expected a finite value >= 0"));
-            for (const Vec3& x : {r.anchor_m, r.last_m})
+            for (double t : {r.time_s, r.older_s, r.newer_s})
+                if (!(t >= 0.0) || !std::isfinite(t)) in.fail(concat("a time at rest of ", t, " s; expected a finite value >= 0"));
+            for (const Vec3& x : {r.anchor_m, r.older_m, r.newer_m})
                 if (!(std::abs(x.x) <= kNowhere && std::abs(x.y) <= kNowhere && std::abs(x.z) <= kNowhere))
                     in.fail(concat("a body's place at rest at (", x.x, ", ", x.y, ", ", x.z, ") m; expected finite coordinates"));
             if (static_cast<int>(r.motion) > static_cast<int>(Motion::moving))

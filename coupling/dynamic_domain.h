@@ -1,8 +1,8 @@
 // Only what moves: spheres and rocks at rest, away from the machine and from moving material, are frozen (held
 // still, out of the integration and of the contacts between frozen bodies) and let go when something moving
 // comes within a margin. At rest means going nowhere: a body that stays within rest_speed x rest_time of one point
-// for rest_time, however it jitters there, and went no faster than the rest speed over the last coupling step.
-// Moving means going somewhere fast: more than ten times the rest speed over the last coupling step. What lies
+// for rest_time, however it jitters there, and went no faster than the rest speed of late (over the last 10-20 ms at
+// the default rest time). Moving means going somewhere fast: more than ten times the rest speed of late. What lies
 // between (a slow creep) neither freezes nor keeps others from freezing. The thesis' simplified model held its
 // resting particles fixed by hand; EDEM calls the same a dynamic domain.
 #pragma once
@@ -22,12 +22,12 @@ class CoupledWorld;
 struct DynamicDomainSettings {
     bool enabled = false;
     /// A body is frozen only if nothing moving (a sphere or rock that moved faster than kMovingFactor x rest_speed
-    /// over the last coupling step, a moving wall's bounding sphere) lies in its cell of this size or the 26 around
+    /// of late, a moving wall's bounding sphere) lies in its cell of this size or the 26 around
     /// it: at least this far from it.
     double margin_m = 1.0;
     /// At rest: the centre (a rock's bounding centre) has stayed within rest_speed x rest_time of one point for
     /// rest_time (on average no faster than this, whatever its speed of the moment) and went no faster than this
-    /// over the last coupling step.
+    /// of late (over the last rest_time_s / 20 to rest_time_s / 10).
     double rest_speed_m_per_s = 0.01;
     /// ... over at least this long.
     double rest_time_s = 0.2;
@@ -45,9 +45,9 @@ public:
     /// bodies frozen or let go.
     void update(CoupledWorld& coupled, double interval_s);
 
-    /// Moving: a mean speed over the last coupling step above this times the rest speed. The coupling's jitter and a
-    /// settling pile's creep stay below it (in a settled mix of Table 1 with Bullet every 20 DEM steps, rocks go a
-    /// median 5 mm/s, p90 12 mm/s, at a rest speed of 10 mm/s); material the machine sets going exceeds it at once.
+    /// Moving: a mean speed over the last 10-20 ms (at the default rest time) above this times the rest speed. A
+    /// settling pile's creep and the rattle of bodies that ring in place stay below it; material the machine sets
+    /// going exceeds it within a few milliseconds.
     static constexpr double kMovingFactor = 10.0;
 
     /// Whether the sphere with this particle id counted as moving at the last update (nothing within the margin of
@@ -56,6 +56,10 @@ public:
 
     std::size_t frozen_spheres() const { return frozen_spheres_; }
     std::size_t frozen_rocks() const { return frozen_rocks_; }
+    /// Spheres and rocks that were at rest (frozen or kept from freezing by something moving near them) and that
+    /// moved, at the last update.
+    std::size_t resting_bodies() const { return resting_bodies_; }
+    std::size_t moving_bodies() const { return moving_bodies_; }
 
     void write_state(StateWriter& out) const;
     void read_state(StateReader& in);
@@ -73,21 +77,29 @@ private:
     bool any_cell(const Vec3& lo_m, const Vec3& hi_m, Visit visit) const;
 
     /// One body's rest: the point it has stayed near and for how long. A body that leaves the reach of its anchor
-    /// gets a new anchor where it is and starts again from 0 s; a new body's anchor is at infinity.
+    /// gets a new anchor where it is and starts again from 0 s; a new body's anchor is at infinity. Its speed is its
+    /// mean over a window of one to two kWindowsPerRestTime-ths of the rest time (10-20 ms at 0.2 s): from where it
+    /// was when the older of its two windows began to where it is; a window of one coupling step would read a body
+    /// that rings in place (a rattler in a rock cage, a rock under Bullet's sawtooth) as going somewhere.
     static constexpr double kNowhere = 1e300;
     enum class Motion : std::uint64_t { resting, creeping, moving };  // 64 bits: a Rest has no padding to checkpoint
     struct Rest {
         Vec3 anchor_m{kNowhere, kNowhere, kNowhere};
-        Vec3 last_m{kNowhere, kNowhere, kNowhere};  ///< where it was at the last update
-        double time_s = 0.0;  ///< how long it has stayed within reach of its anchor
+        Vec3 older_m{kNowhere, kNowhere, kNowhere};  ///< where it was when the older window began
+        Vec3 newer_m{kNowhere, kNowhere, kNowhere};  ///< ... and the newer one
+        double time_s = 0.0;   ///< how long it has stayed within reach of its anchor
+        double older_s = 0.0;  ///< how long ago the older window began
+        double newer_s = 0.0;  ///< ... and the newer one
         Motion motion = Motion::creeping;
     };
+    static constexpr double kWindowsPerRestTime = 20.0;
     /// The body now at x, after interval_s: its rest moved on and what it did.
     Motion advance(Rest& rest, const Vec3& x, double interval_s) const;
 
     DynamicDomainSettings settings_;
     std::vector<Rest> sphere_rest_;  ///< by particle id
     std::vector<Rest> rock_rest_;    ///< by rock (CoupledWorld::rocks() order)
+    std::size_t resting_bodies_ = 0, moving_bodies_ = 0;
     std::size_t frozen_spheres_ = 0, frozen_rocks_ = 0;
     // the grid of the last update (scratch)
     Vec3 lo_m_;

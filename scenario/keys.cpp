@@ -119,7 +119,7 @@ const std::vector<KeySpec>& scenario_keys()
 
         {"dynamic_domain", "map", "none", "freeze spheres and rocks at rest away from the machine and moving material (docs/coupling.md); none: every body moves"},
         {"dynamic_domain.margin_m", "number", "1.0", "how far from anything moving a body must be to freeze (cells this wide)"},
-        {"dynamic_domain.rest_speed_m_per_s", "number", "0.01", "at rest: on average no faster than this (stays within this times rest_time_s of one point) and no faster over the last coupling step; moving: faster than ten times this over a coupling step"},
+        {"dynamic_domain.rest_speed_m_per_s", "number", "0.01", "at rest: on average no faster than this (stays within this times rest_time_s of one point) and no faster over the last rest_time_s/20 to rest_time_s/10; moving: faster than ten times this over that window"},
         {"dynamic_domain.rest_time_s", "number", "0.2", "over this long (> 0): at rest when it has stayed so near one point this long"},
 
         {"shovel", "map", "none", "the rope shovel (docs/machine.md), driven by motion curves"},

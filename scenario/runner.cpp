@@ -33,7 +33,7 @@ using detail::json_number;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "dipper-checkpoint 8";
+constexpr const char* kCheckpointMagic = "dipper-checkpoint 9";
 
 /// The checkpoint's "run" section: the scenario as it was read, and the thread count (same threads, same bits).
 struct RunHeader {

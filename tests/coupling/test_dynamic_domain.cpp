@@ -101,7 +101,7 @@ TEST_CASE("a sphere thrown at a frozen bed lets go what it comes near, and only 
         const dem::ParticleStore& p = s->dem.particles();
         // Whatever moves is never closer than the margin less the two radii to a frozen sphere: the grid's cells are
         // margin wide and a frozen sphere has none of its 27 cells holding anything that moved. Moving: faster than
-        // ten times the rest speed over the last coupling step.
+        // ten times the rest speed of late (over the last 10-20 ms).
         for (std::size_t i = 0; i < p.size(); ++i) {
             if (!d.sphere_moving(p.id[i])) continue;
             REQUIRE_FALSE(p.frozen[i]);
@@ -125,7 +125,7 @@ TEST_CASE("at rest is going nowhere: a slow drift freezes, a creep neither freez
           "[coupling][dynamic_domain]")
 {
     // Spheres in free space (no gravity, no contacts) at constant velocities; rest speed 0.01 m/s over 0.2 s, so at
-    // rest within 2 mm of one point for 0.2 s, moving above 0.1 m/s over a coupling step; margin 0.5 m.
+    // rest within 2 mm of one point for 0.2 s, moving above 0.1 m/s over the last 10-20 ms; margin 0.5 m.
     auto s = make_scene(5, {0.0, 0.0, 0.0});
     const std::uint32_t drift = add_sphere(s->dem, {0.0, 0.0, 0.0}, {0.005, 0.0, 0.0});  // 1 mm in 0.2 s: at rest
     const std::uint32_t creep = add_sphere(s->dem, {3.0, 0.0, 0.0}, {0.03, 0.0, 0.0});   // 6 mm in 0.2 s: never at
@@ -172,6 +172,40 @@ TEST_CASE("a body set going near its resting point does not freeze with the push
     CHECK_FALSE(p.frozen[at(id)]);
     CHECK_FALSE(d.sphere_moving(id));
     CHECK(p.velocity_m_per_s[at(id)].x == Approx(0.05).epsilon(1e-12));
+}
+
+TEST_CASE("a body that rings in place is not moving: what lies beside it freezes", "[coupling][dynamic_domain]")
+{
+    // A rattler in a rock cage, or a rock under Bullet's sawtooth, goes fast and nowhere. Here a sphere in free space
+    // is set each coupling step to a velocity of 0.3 m/s amplitude at 200 Hz (0.24 mm amplitude of its place) on a
+    // creep of 0.02 m/s, so that it never comes to rest: over a coupling step it often goes faster than the 0.1 m/s
+    // of moving, over the 10-20 ms window at most 0.02 + 2 x 0.24 mm / 10 ms = 0.068 m/s. A sphere 0.3 m from it, at
+    // rest, must freeze and stay frozen; with the speed taken over one coupling step it was let go whenever the
+    // ringing one was fast.
+    auto s = make_scene(5, {0.0, 0.0, 0.0});
+    const std::uint32_t ringing = add_sphere(s->dem, {0.0, 0.0, 0.0});
+    const std::uint32_t beside = add_sphere(s->dem, {0.0, 0.3, 0.0});
+    dem::ParticleStore& p = s->dem.particles();
+    auto at = [&](std::uint32_t k) { return static_cast<std::size_t>(std::find(p.id.begin(), p.id.end(), k) - p.id.begin()); };
+    coupling::DynamicDomain d({true, 0.5, 0.01, 0.2});
+    const double amplitude = 0.3, omega = 2.0 * M_PI * 200.0;
+    int updates = 0, frozen_beside = 0, fast_steps = 0;
+    while (s->world.time_s() < 0.5) {
+        const double v = 0.02 + amplitude * std::cos(omega * (s->world.time_s() + 0.5 * s->world.coupling_step_s()));
+        p.velocity_m_per_s[at(ringing)] = {v, 0.0, 0.0};
+        fast_steps += std::abs(v) > 0.1 ? 1 : 0;
+        s->world.step();
+        d.update(s->world, s->world.coupling_step_s());
+        if (s->world.time_s() > 0.3) {  // past the rest time and a window
+            ++updates;
+            frozen_beside += p.frozen[at(beside)] ? 1 : 0;
+            CHECK_FALSE(d.sphere_moving(ringing));
+        }
+    }
+    REQUIRE(fast_steps > 1000);  // the ringing sphere was faster than moving over a coupling step most of the time
+    CHECK(p.position_m[at(ringing)].x == Approx(0.01).margin(5e-4));  // and went no farther than its creep
+    CHECK(frozen_beside == updates);
+    CHECK_FALSE(p.frozen[at(ringing)]);  // the creep keeps it from freezing itself
 }
 
 TEST_CASE("a frozen bed's walls carried over at a rebuild give the bits of a search", "[coupling][dynamic_domain]")

@@ -405,7 +405,7 @@ TEST_CASE("a truncated or corrupt checkpoint is refused and the previous one is 
         f << "something else entirely\n";
     }
     CHECK_THROWS_WITH(resume_run((base / "a").string(), quiet()),
-                      Catch::Contains("is not a state file of this kind") && Catch::Contains("dipper-checkpoint 8"));
+                      Catch::Contains("is not a state file of this kind") && Catch::Contains("dipper-checkpoint 9"));
     // the previous checkpoint still resumes
     const RunResult r = resume_run((base / "a").string(), quiet(), prev.string());
     CHECK(r.status == RunStatus::completed);
