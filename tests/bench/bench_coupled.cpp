@@ -3,7 +3,7 @@
 // Spheres 200 mm; rocks of Table 1's classes in Table 1's mass ratios among themselves; Aitik ore (Table 2).
 // Usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]
 //                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]
-//                             [--turn N] [--full-mix]
+//                             [--turn N] [--full-mix] [--dynamic-domain 0.01,0.05]
 // --substeps: a list of n; "n:dem_step" runs n with the rocks taking the spheres' forces at every DEM step
 // (coupling::RockExchange::dem_step), plain n with the default exchange at Bullet's step.
 // --full-mix: the full-size loading model's mix on a tenth of its size (14,500 spheres of 200 mm and 2,000 rocks
@@ -18,9 +18,14 @@
 // machine whose speed drifts by tens of per cent within minutes, so the median of those ratios is the steadier
 // figure. Without --turn each variant runs its --steps in one go.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
+// --dynamic-domain: one more variant per rest speed (m/s) given, at the last --substeps value, with the dynamic
+// domain (coupling/dynamic_domain.h, margin and rest time at their defaults) deciding after each coupling step what
+// is frozen; it prints how much froze. Every variant then warms up for the rest time and 0.05 s more (instead of
+// 200 DEM steps), so that what is at rest has frozen before the timing starts.
 // Each variant ends with the spheres' state hash (the one summary.json gives): a change that should not move
 // results must keep it.
 #include "coupling/coupled_world.h"
+#include "coupling/dynamic_domain.h"
 #include "coupling/mixed_bed.h"
 #include "core/errors.h"
 #include "meshes/mesh_builder.h"
@@ -36,6 +41,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -95,11 +101,11 @@ int main(int argc, char** argv)
     int spheres = 20000, rocks = 1000, threads = 1, steps = 400, turn = 0;
     double dt = 5e-5, settle_s = 0.6;
     std::string cache, substeps_list = "1,5,10,20";
-    std::string pairs = "dipper", guard = "off";
+    std::string pairs = "dipper", guard = "off", rest_speeds;
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
         "                            [--substeps 1,5,10,20,20:dem_step] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n"
-        "                            [--turn N] [--full-mix]\n";
+        "                            [--turn N] [--full-mix] [--dynamic-domain 0.01,0.05]\n";
     // --full-mix is a flag: its settings first, the options given after it override them
     bool full_mix = false;
     std::vector<char*> args{argv[0]};
@@ -128,6 +134,7 @@ int main(int argc, char** argv)
         else if (key == "--pairs") pairs = value;
         else if (key == "--runaway-guard") guard = value;
         else if (key == "--turn") turn = std::atoi(value);
+        else if (key == "--dynamic-domain") rest_speeds = value;
         else return false;
         return true;
     });
@@ -155,6 +162,21 @@ int main(int argc, char** argv)
                 return 2;
             }
             exchanges.push_back(exchange == "dem_step" ? coupling::RockExchange::dem_step : coupling::RockExchange::coupling_step);
+        }
+    }
+
+    std::vector<double> domain_rest_speeds;
+    {
+        std::stringstream ss(rest_speeds);
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+            char* end = nullptr;
+            const double v = std::strtod(item.c_str(), &end);
+            if (end == item.c_str() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
+                std::fprintf(stderr, "--dynamic-domain: '%s'; expected rest speeds in m/s > 0, e.g. 0.01,0.05\n", item.c_str());
+                return 2;
+            }
+            domain_rest_speeds.push_back(v);
         }
     }
 
@@ -198,6 +220,16 @@ int main(int argc, char** argv)
     // until each has timed --steps (one turn by default: each variant in one go, as before)
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
     exchanges.insert(exchanges.begin(), coupling::RockExchange::coupling_step);
+    std::vector<double> variant_rest_speed(variants.size(), 0.0);  // 0: no dynamic domain
+    for (double v : domain_rest_speeds) {
+        variants.push_back(variants.back());
+        exchanges.push_back(exchanges.back());
+        variant_rest_speed.push_back(v);
+    }
+    if (!domain_rest_speeds.empty() && variants.back() == 0) {
+        std::fprintf(stderr, "--dynamic-domain: the last --substeps value is 0; expected a coupled one\n");
+        return 2;
+    }
     if (steps < 1) {
         std::fprintf(stderr, "--steps %d: expected a number of timed DEM steps >= 1\n", steps);
         return 2;
@@ -229,6 +261,7 @@ int main(int argc, char** argv)
         double r0 = 0.0, s0 = 0.0, sim0 = 0.0, wall = 0.0;
         std::vector<double> turn_s;  ///< wall time of each turn
         std::string failed;          ///< the error that stopped it
+        std::unique_ptr<coupling::DynamicDomain> domain;  ///< with --dynamic-domain
     };
     std::vector<Run> runs;
     for (std::size_t v = 0; v < variants.size(); ++v) {
@@ -237,6 +270,13 @@ int main(int argc, char** argv)
         Run r;
         r.n = n;
         r.name = n == 0 ? "DEM only" : "n = " + std::to_string(n) + (at_dem_rate ? ", rocks at the DEM's rate" : "");
+        if (variant_rest_speed[v] > 0.0) {
+            coupling::DynamicDomainSettings dd;
+            dd.enabled = true;
+            dd.rest_speed_m_per_s = variant_rest_speed[v];
+            r.domain = std::make_unique<coupling::DynamicDomain>(dd);
+            r.name += concat(", dynamic domain at ", variant_rest_speed[v], " m/s");
+        }
         r.bed = std::make_unique<Bed>(dt, threads, std::max(n, 1), bullet_pairs, guard == "on", exchanges[v]);
         r.bed->add_box(side, height + 1.0);
         coupling::load_state(r.bed->world, cache);
@@ -248,13 +288,24 @@ int main(int argc, char** argv)
             if (r.n == 0)
                 r.bed->dem.run_steps(static_cast<std::uint64_t>(dem_steps));
             else
-                for (int k = 0; k < dem_steps / r.n; ++k) r.bed->world.step();
+                for (int k = 0; k < dem_steps / r.n; ++k) {
+                    r.bed->world.step();
+                    if (r.domain) r.domain->update(r.bed->world, r.bed->world.coupling_step_s());
+                }
         } catch (const SimulationError& e) {
             r.failed = concat("stopped at step ", r.bed->dem.step_count(), ": ", e.what());
         }
     };
+    // warm-up: 200 DEM steps, or with a dynamic domain its rest time and 0.05 s more, in whole coupling steps
+    int warm_steps = 200;
+    if (!domain_rest_speeds.empty()) {
+        int lcm = 1;
+        for (int n : variants)
+            if (n > 0) lcm = std::lcm(lcm, n);
+        warm_steps = static_cast<int>(std::ceil((coupling::DynamicDomainSettings{}.rest_time_s + 0.05) / dt / lcm)) * lcm;
+    }
     for (Run& r : runs) {
-        advance(r, 200);  // warm-up
+        advance(r, warm_steps);
         r.p0 = r.bed->dem.phase_seconds();
         r.r0 = r.bed->world.rigid_seconds();
         r.s0 = r.bed->world.surface_seconds();
@@ -301,6 +352,10 @@ int main(int argc, char** argv)
                     (p.integration - r.p0.integration) * per, (bed.world.rigid_seconds() - r.r0) * per,
                     (bed.world.surface_seconds() - r.s0) * per, alone.failed.empty() ? r.wall / alone.wall : 0.0, turns,
                     bed.dem.pair_contact_count(), body_contacts, static_cast<unsigned long long>(scenario::particle_state_hash(bed.dem)));
+        if (r.domain)
+            std::printf("  %s: %zu of %zu spheres and %zu of %zu rocks frozen at the end; %zu bodies at rest, %zu moving\n", r.name.c_str(),
+                        r.domain->frozen_spheres(), bed.dem.particles().size(), r.domain->frozen_rocks(), bed.world.rocks().size(),
+                        r.domain->resting_bodies(), r.domain->moving_bodies());
         if (guard == "on" && r.n > 1)
             std::printf("  %s: runaway guard set off %llu times, %llu coupling steps guarded\n", r.name.c_str(),
                         static_cast<unsigned long long>(bed.world.runaways_caught()),
@@ -311,7 +366,14 @@ int main(int argc, char** argv)
     getrusage(RUSAGE_SELF, &u);
     std::printf("peak memory %.0f MiB\n", u.ru_maxrss / 1024.0);
     // the full mix's summary, one line per coupled variant (the default's alone: the last line)
-    for (std::size_t v = 1; full_mix && v < runs.size(); ++v) {
+    // (the dynamic-domain variants first, so that the last line stays the default's)
+    std::vector<std::size_t> order;
+    for (std::size_t v = 1; v < runs.size(); ++v)
+        if (runs[v].domain) order.push_back(v);
+    for (std::size_t v = 1; v < runs.size(); ++v)
+        if (!runs[v].domain) order.push_back(v);
+    for (std::size_t v : order) {
+        if (!full_mix) break;
         const Run& held = runs[0];
         const Run& coupled = runs[v];
         if (!held.failed.empty() || !coupled.failed.empty()) continue;
