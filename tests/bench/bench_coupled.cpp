@@ -3,7 +3,7 @@
 // Spheres 200 mm; rocks of Table 1's classes in Table 1's mass ratios among themselves; Aitik ore (Table 2).
 // Usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]
 //                             [--substeps 1,5,10,20] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]
-//                             [--turn N] [--full-mix] [--dynamic-domain 0.01,0.05]
+//                             [--turn N] [--full-mix] [--dynamic-domain 0.01,0.05/0.5]
 // --substeps: a list of n; "n:dem_step" runs n with the rocks taking the spheres' forces at every DEM step
 // (coupling::RockExchange::dem_step), plain n with the default exchange at Bullet's step.
 // --full-mix: the full-size loading model's mix on a tenth of its size (14,500 spheres of 200 mm and 2,000 rocks
@@ -19,7 +19,7 @@
 // figure. Without --turn each variant runs its --steps in one go.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
 // --dynamic-domain: one more variant per rest speed (m/s) given, at the last --substeps value, with the dynamic
-// domain (coupling/dynamic_domain.h, margin and rest time at their defaults) deciding after each coupling step what
+// domain (coupling/dynamic_domain.h, the rest time at its default; "speed/margin" sets the margin in m, else 1 m) deciding after each coupling step what
 // is frozen; it prints how much froze. Every variant then warms up for the rest time and 0.05 s more (instead of
 // 200 DEM steps), so that what is at rest has frozen before the timing starts.
 // Each variant ends with the spheres' state hash (the one summary.json gives): a change that should not move
@@ -105,7 +105,7 @@ int main(int argc, char** argv)
     const char* usage =
         "usage: dipper_bench_coupled [--spheres N] [--rocks N] [--dt S] [--threads N] [--steps N] [--settle-s S]\n"
         "                            [--substeps 1,5,10,20,20:dem_step] [--cache FILE] [--pairs dipper|bullet] [--runaway-guard on|off]\n"
-        "                            [--turn N] [--full-mix] [--dynamic-domain 0.01,0.05]\n";
+        "                            [--turn N] [--full-mix] [--dynamic-domain 0.01,0.05/0.5]\n";
     // --full-mix is a flag: its settings first, the options given after it override them
     bool full_mix = false;
     std::vector<char*> args{argv[0]};
@@ -165,18 +165,27 @@ int main(int argc, char** argv)
         }
     }
 
-    std::vector<double> domain_rest_speeds;
+    std::vector<coupling::DynamicDomainSettings> domains;
     {
         std::stringstream ss(rest_speeds);
         std::string item;
         while (std::getline(ss, item, ',')) {
+            coupling::DynamicDomainSettings dd;
+            dd.enabled = true;
             char* end = nullptr;
-            const double v = std::strtod(item.c_str(), &end);
-            if (end == item.c_str() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
-                std::fprintf(stderr, "--dynamic-domain: '%s'; expected rest speeds in m/s > 0, e.g. 0.01,0.05\n", item.c_str());
+            dd.rest_speed_m_per_s = std::strtod(item.c_str(), &end);
+            if (end != item.c_str() && *end == '/') {
+                const char* margin = end + 1;
+                dd.margin_m = std::strtod(margin, &end);
+                if (end == margin) end = const_cast<char*>("?");
+            }
+            if (end == item.c_str() || *end != '\0' || !(dd.rest_speed_m_per_s > 0.0) || !std::isfinite(dd.rest_speed_m_per_s) ||
+                !(dd.margin_m > 0.0) || !std::isfinite(dd.margin_m)) {
+                std::fprintf(stderr, "--dynamic-domain: '%s'; expected rest speeds in m/s > 0, each with a margin in m > 0 if "
+                                     "wanted, e.g. 0.01,0.05/0.5\n", item.c_str());
                 return 2;
             }
-            domain_rest_speeds.push_back(v);
+            domains.push_back(dd);
         }
     }
 
@@ -220,13 +229,13 @@ int main(int argc, char** argv)
     // until each has timed --steps (one turn by default: each variant in one go, as before)
     variants.insert(variants.begin(), 0);  // 0: the DEM alone
     exchanges.insert(exchanges.begin(), coupling::RockExchange::coupling_step);
-    std::vector<double> variant_rest_speed(variants.size(), 0.0);  // 0: no dynamic domain
-    for (double v : domain_rest_speeds) {
+    std::vector<coupling::DynamicDomainSettings> variant_domain(variants.size());  // not enabled: none
+    for (const coupling::DynamicDomainSettings& dd : domains) {
         variants.push_back(variants.back());
         exchanges.push_back(exchanges.back());
-        variant_rest_speed.push_back(v);
+        variant_domain.push_back(dd);
     }
-    if (!domain_rest_speeds.empty() && variants.back() == 0) {
+    if (!domains.empty() && variants.back() == 0) {
         std::fprintf(stderr, "--dynamic-domain: the last --substeps value is 0; expected a coupled one\n");
         return 2;
     }
@@ -270,12 +279,9 @@ int main(int argc, char** argv)
         Run r;
         r.n = n;
         r.name = n == 0 ? "DEM only" : "n = " + std::to_string(n) + (at_dem_rate ? ", rocks at the DEM's rate" : "");
-        if (variant_rest_speed[v] > 0.0) {
-            coupling::DynamicDomainSettings dd;
-            dd.enabled = true;
-            dd.rest_speed_m_per_s = variant_rest_speed[v];
-            r.domain = std::make_unique<coupling::DynamicDomain>(dd);
-            r.name += concat(", dynamic domain at ", variant_rest_speed[v], " m/s");
+        if (variant_domain[v].enabled) {
+            r.domain = std::make_unique<coupling::DynamicDomain>(variant_domain[v]);
+            r.name += concat(", dynamic domain at ", variant_domain[v].rest_speed_m_per_s, " m/s, margin ", variant_domain[v].margin_m, " m");
         }
         r.bed = std::make_unique<Bed>(dt, threads, std::max(n, 1), bullet_pairs, guard == "on", exchanges[v]);
         r.bed->add_box(side, height + 1.0);
@@ -298,7 +304,7 @@ int main(int argc, char** argv)
     };
     // warm-up: 200 DEM steps, or with a dynamic domain its rest time and 0.05 s more, in whole coupling steps
     int warm_steps = 200;
-    if (!domain_rest_speeds.empty()) {
+    if (!domains.empty()) {
         int lcm = 1;
         for (int n : variants)
             if (n > 0) lcm = std::lcm(lcm, n);
