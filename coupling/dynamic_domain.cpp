@@ -93,14 +93,21 @@ bool DynamicDomain::any_cell(const Vec3& lo, const Vec3& hi, Visit visit) const
 void DynamicDomain::mark(const Vec3& lo, const Vec3& hi)
 {
     any_cell(lo, hi, [this](std::size_t c) {
-        hot_[c] = 1;
+        heat(c);
         return false;
     });
 }
 
+void DynamicDomain::heat(std::size_t cell)
+{
+    if (hot_stamp_[cell] == stamp_) return;
+    hot_stamp_[cell] = stamp_;
+    hot_cells_.push_back(cell);
+}
+
 bool DynamicDomain::near(const Vec3& lo, const Vec3& hi) const
 {
-    return any_cell(lo, hi, [this](std::size_t c) { return near_[c] != 0; });
+    return any_cell(lo, hi, [this](std::size_t c) { return near_stamp_[c] == stamp_; });
 }
 
 void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
@@ -163,12 +170,25 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     }
     for (int a = 0; a < 3; ++a) dims_[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell_m_)) + 1;
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
-    hot_.assign(cells, 0);
+    // Which cells are hot and near is kept as this update's stamp in arrays over the grid, so that an update touches
+    // the cells near moving things and the bodies' own, never the whole grid: bodies spread from the dig to the truck
+    // make a grid of millions of cells at a margin of 0.3 m, and clearing it at every coupling step cost more than
+    // the steps themselves.
+    if (near_stamp_.size() < cells) {
+        hot_stamp_.assign(cells, 0);
+        near_stamp_.assign(cells, 0);
+    }
+    if (++stamp_ == 0) {  // the stamps wrapped: every cell to 0 once, this update 1
+        std::fill(hot_stamp_.begin(), hot_stamp_.end(), 0);
+        std::fill(near_stamp_.begin(), near_stamp_.end(), 0);
+        stamp_ = 1;
+    }
+    hot_cells_.clear();
 
     // 3. the cells with something moving: spheres and rocks that moved, walls that move or may move (a machine
     //    part, a gate) over their bounding sphere
     for (std::size_t i = 0; i < n; ++i)
-        if (sphere_motion[i] == Motion::moving) hot_[cell_index(p.position_m[i])] = 1;
+        if (sphere_motion[i] == Motion::moving) heat(cell_index(p.position_m[i]));
     for (const RockNow& r : rock_now)
         if (r.motion == Motion::moving) mark(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
     for (std::size_t w = 0; w < dem.wall_count(); ++w) {
@@ -186,21 +206,20 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     }
 
     // 4. near: a hot cell and the 26 around it
-    near_.assign(cells, 0);
-    for (int z = 0; z < dims_[2]; ++z)
-        for (int y = 0; y < dims_[1]; ++y)
-            for (int x = 0; x < dims_[0]; ++x) {
-                if (!hot_[(static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x]) continue;
-                for (int zz = std::max(0, z - 1); zz <= std::min(dims_[2] - 1, z + 1); ++zz)
-                    for (int yy = std::max(0, y - 1); yy <= std::min(dims_[1] - 1, y + 1); ++yy)
-                        for (int xx = std::max(0, x - 1); xx <= std::min(dims_[0] - 1, x + 1); ++xx)
-                            near_[(static_cast<std::size_t>(zz) * dims_[1] + yy) * dims_[0] + xx] = 1;
-            }
+    for (std::size_t c : hot_cells_) {
+        const int x = static_cast<int>(c % static_cast<std::size_t>(dims_[0]));
+        const int y = static_cast<int>(c / static_cast<std::size_t>(dims_[0]) % static_cast<std::size_t>(dims_[1]));
+        const int z = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * static_cast<std::size_t>(dims_[1])));
+        for (int zz = std::max(0, z - 1); zz <= std::min(dims_[2] - 1, z + 1); ++zz)
+            for (int yy = std::max(0, y - 1); yy <= std::min(dims_[1] - 1, y + 1); ++yy)
+                for (int xx = std::max(0, x - 1); xx <= std::min(dims_[0] - 1, x + 1); ++xx)
+                    near_stamp_[(static_cast<std::size_t>(zz) * dims_[1] + yy) * dims_[0] + xx] = stamp_;
+    }
 
     // 5. frozen when at rest and not near anything moving, let go when something moving comes near
     frozen_spheres_ = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        const bool freeze = sphere_motion[i] == Motion::resting && !near_[cell_index(p.position_m[i])];
+        const bool freeze = sphere_motion[i] == Motion::resting && near_stamp_[cell_index(p.position_m[i])] != stamp_;
         if (freeze != (p.frozen[i] != 0)) dem.set_frozen(i, freeze);
         frozen_spheres_ += freeze ? 1 : 0;
     }

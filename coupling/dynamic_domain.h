@@ -71,6 +71,8 @@ private:
     /// The cells (margin_m wide, or wider where the bodies spread far) that hold moving things, and those next to them.
     void mark(const Vec3& lo_m, const Vec3& hi_m);
     std::size_t cell_index(const Vec3& p) const;
+    /// Marks a cell hot (once).
+    void heat(std::size_t cell);
     bool near(const Vec3& lo_m, const Vec3& hi_m) const;
     /// Calls visit(cell) for the cells a box overlaps until it returns true; whether one did.
     template <class Visit>
@@ -105,7 +107,10 @@ private:
     Vec3 lo_m_;
     double cell_m_ = 1.0;
     int dims_[3] = {1, 1, 1};
-    std::vector<std::uint8_t> hot_, near_;
+    /// A cell is hot (near) in this update when its stamp is stamp_; the hot cells listed once each.
+    std::vector<std::uint16_t> hot_stamp_, near_stamp_;
+    std::uint16_t stamp_ = 0;
+    std::vector<std::size_t> hot_cells_;
 };
 
 }  // namespace dipper::coupling
