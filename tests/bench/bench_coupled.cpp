@@ -19,8 +19,8 @@
 // figure. Without --turn each variant runs its --steps in one go.
 // --pairs bullet: rock-rock pairs in Bullet's own convex-convex algorithm (RigidSettings::bullet_convex_pairs).
 // --dynamic-domain: one more variant per rest speed (m/s) given, at the last --substeps value, with the dynamic
-// domain (coupling/dynamic_domain.h, the rest time at its default; "speed/margin" sets the margin in m, else 1 m) deciding after each coupling step what
-// is frozen; it prints how much froze. Every variant then warms up for the rest time and 0.05 s more (instead of
+// domain (coupling/dynamic_domain.h; "speed/margin" sets the margin in m, else 1 m; the rest time at its default)
+// deciding after each coupling step what is frozen; it prints how much froze. Every variant then warms up for the rest time and 0.05 s more (instead of
 // 200 DEM steps), so that what is at rest has frozen before the timing starts.
 // Each variant ends with the spheres' state hash (the one summary.json gives): a change that should not move
 // results must keep it.
@@ -174,12 +174,13 @@ int main(int argc, char** argv)
             dd.enabled = true;
             char* end = nullptr;
             dd.rest_speed_m_per_s = std::strtod(item.c_str(), &end);
-            if (end != item.c_str() && *end == '/') {
+            bool read = end != item.c_str();
+            if (read && *end == '/') {
                 const char* margin = end + 1;
                 dd.margin_m = std::strtod(margin, &end);
-                if (end == margin) end = const_cast<char*>("?");
+                read = end != margin;
             }
-            if (end == item.c_str() || *end != '\0' || !(dd.rest_speed_m_per_s > 0.0) || !std::isfinite(dd.rest_speed_m_per_s) ||
+            if (!read || *end != '\0' || !(dd.rest_speed_m_per_s > 0.0) || !std::isfinite(dd.rest_speed_m_per_s) ||
                 !(dd.margin_m > 0.0) || !std::isfinite(dd.margin_m)) {
                 std::fprintf(stderr, "--dynamic-domain: '%s'; expected rest speeds in m/s > 0, each with a margin in m > 0 if "
                                      "wanted, e.g. 0.01,0.05/0.5\n", item.c_str());
