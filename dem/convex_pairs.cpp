@@ -91,6 +91,23 @@ void ConvexPairs::build(const std::vector<std::uint32_t>& candidate_start, const
     for (std::size_t k = 0; k < pairs_.size(); ++k) pair_index_[pair_start_[pairs_[k].particle]++] = static_cast<std::uint32_t>(k);
     for (std::size_t i = n; i > 0; --i) pair_start_[i] = pair_start_[i - 1];  // the fill moved each start to the next
     if (n > 0) pair_start_[0] = 0;
+    live_stale_ = true;
+}
+
+void ConvexPairs::find_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& mesh_frozen)
+{
+    // A frozen sphere against a frozen body keeps its contact as it was and adds nothing: compute passes over such
+    // pairs without touching their data (in a bed frozen to 97 % they are most of the pairs, and reading each one's
+    // frame and fetching its faces ahead cost a fifth of the step).
+    live_.clear();
+    frozen_touching_ = 0;
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+        if (mesh_frozen[pairs_[k].mesh] && particle_frozen[pairs_[k].particle])
+            frozen_touching_ += touching_[k];
+        else
+            live_.push_back(static_cast<std::uint32_t>(k));
+    }
+    live_stale_ = false;
 }
 
 void ConvexPairs::append_contacts(std::vector<WallContact>& out) const
@@ -174,22 +191,22 @@ std::size_t ConvexPairs::compute(std::size_t begin, std::size_t end, const Parti
         for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(static_cast<const char*>(at) + line);
     };
     std::size_t touching = 0;
-    for (std::size_t k = begin; k < end; ++k) {
+    const auto live_begin = static_cast<std::size_t>(std::lower_bound(live_.begin(), live_.end(), begin) - live_.begin());
+    const auto live_end = static_cast<std::size_t>(std::lower_bound(live_.begin(), live_.end(), end) - live_.begin());
+    for (std::size_t q = live_begin; q < live_end; ++q) {
+        const std::size_t k = live_[q];
         const Pair pair = pairs_[k];
-        if (k + kAhead < end) {
-            const Pair& next = pairs_[k + kAhead];
+        if (q + kAhead < live_end) {
+            const std::size_t ahead = live_[q + kAhead];
+            const Pair& next = pairs_[ahead];
             prefetch(&frames[next.mesh], sizeof(ConvexFrame));
-            prefetch(&contacts_[k + kAhead], sizeof(WallContact));
-            prefetch(&constants_[k + kAhead], sizeof(ContactConstants));
+            prefetch(&contacts_[ahead], sizeof(WallContact));
+            prefetch(&constants_[ahead], sizeof(ContactConstants));
             prefetch(&faces_[next.face_begin], kFaceLines * 64);
             prefetch(&face_across_[next.face_begin], kAcrossLines * 64);
         }
         const ConvexFrame& frame = frames[pair.mesh];
         const std::uint32_t i = pair.particle;
-        if (frame.frozen && particles.frozen[i]) {  // two frozen bodies: the contact stays as it was, no reaction
-            touching += touching_[k];
-            continue;
-        }
         const Vec3 x = particles.position_m[i];
         const double r = particles.radius_m[i];
         const Vec3 xb = frame.to_body * (x - frame.translation_m);

@@ -78,6 +78,7 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
 void World::set_frozen(std::size_t i, bool frozen)
 {
     if (i >= particles_.size()) throw InputError(concat("set_frozen: particle index ", i, " of ", particles_.size()));
+    if (particles_.frozen[i] != (frozen ? 1 : 0)) frozen_changed_ = true;
     particles_.frozen[i] = frozen ? 1 : 0;
     if (!frozen) return;
     particles_.velocity_m_per_s[i] = Vec3{};
@@ -93,6 +94,7 @@ void World::set_wall_frozen(int wall_id, bool frozen)
     const auto w = static_cast<std::size_t>(wall_id);
     if (wall_frozen_[w] == (frozen ? 1 : 0)) return;
     wall_frozen_[w] = frozen ? 1 : 0;
+    frozen_changed_ = true;
     mesh_moved_[static_cast<std::size_t>(walls_[w].index)] = 1;  // its frame is made again with the flag
 }
 
@@ -513,6 +515,13 @@ void World::compute_wall_contacts(double dt_s)
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
     convex_.start_step(threads_);
+    if (frozen_changed_ || convex_.live_stale()) {
+        mesh_frozen_.resize(meshes_.size());
+        for (std::size_t m = 0; m < meshes_.size(); ++m) mesh_frozen_[m] = wall_frozen_[static_cast<std::size_t>(mesh_wall_id_[m])];
+        convex_.find_live(particles_.frozen, mesh_frozen_);
+        frozen_changed_ = false;
+    }
+    convex_touching = convex_.frozen_touching();
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {
         // the records of the meshes moved (or given a mass) since the last wall phase: in a coupled bed every rock
