@@ -94,7 +94,8 @@ void ConvexPairs::build(const std::vector<std::uint32_t>& candidate_start, const
     live_stale_ = true;
 }
 
-void ConvexPairs::find_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& mesh_frozen)
+void ConvexPairs::find_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& mesh_frozen,
+                            std::uint64_t frozen_version)
 {
     // A frozen sphere against a frozen body keeps its contact as it was and adds nothing: compute passes over such
     // pairs without touching their data (in a bed frozen to 97 % they are most of the pairs, and reading each one's
@@ -108,6 +109,7 @@ void ConvexPairs::find_live(const std::vector<std::uint8_t>& particle_frozen, co
             live_.push_back(static_cast<std::uint32_t>(k));
     }
     live_stale_ = false;
+    live_frozen_version_ = frozen_version;
 }
 
 void ConvexPairs::append_contacts(std::vector<WallContact>& out) const

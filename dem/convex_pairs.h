@@ -38,12 +38,12 @@ public:
     std::size_t pass_end(int t) const { return pass_start_[static_cast<std::size_t>(t) + 1]; }
     /// A body's mass changed: every pair's law constants are found again at its next contact.
     void forget_constants() { constants_stale_ = true; }
-    /// Whether the pairs of a frozen sphere and a frozen body must be found again (after a build; the caller also
-    /// asks when a frozen flag changed) before compute.
-    bool live_stale() const { return live_stale_; }
+    /// Whether the pairs of a frozen sphere and a frozen body must be found again before compute: after a build, or
+    /// when `frozen_version` (the caller's count of changes of the frozen flags) is not the one they were found for.
+    bool live_stale(std::uint64_t frozen_version) const { return live_stale_ || live_frozen_version_ != frozen_version; }
     /// The pairs compute works on: all but those of a frozen particle (`particle_frozen`) and a frozen body
     /// (`mesh_frozen`, by mesh index), whose contacts stay as they were; how many of those touch is kept.
-    void find_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& mesh_frozen);
+    void find_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& mesh_frozen, std::uint64_t frozen_version);
     /// The pairs left out by find_live that touch (their contacts stand as they were).
     std::size_t frozen_touching() const { return frozen_touching_; }
     /// The contacts of the live pairs among [begin, end) (find_live): each touching pair's push on its sphere and
@@ -108,6 +108,7 @@ private:
     std::vector<std::uint32_t> live_;
     std::size_t frozen_touching_ = 0;
     bool live_stale_ = true;
+    std::uint64_t live_frozen_version_ = 0;
 };
 
 template <class MeshOf>

@@ -57,9 +57,11 @@ public:
     void rebuild(const ParticleStore& p, const CellGrid& grid, double skin_m, const std::vector<std::uint32_t>& old_to_new, int threads);
 
     /// The forces of the touching pairs, each thread's block of pairs into its own arrays (same thread count, same
-    /// bits); the springs into the history. Returns the largest overlap over the smaller radius.
+    /// bits); the springs into the history. A pair of two frozen particles keeps its contact as it was and is passed
+    /// over: the pairs left are found again when the list or `frozen_version` (which counts changes of the
+    /// particles' frozen flags) changes. Returns the largest overlap over the smaller radius.
     double compute_forces(const ParticleStore& p, const std::vector<double>& stiffness_radius_N_per_m, const MaterialTable& materials,
-                          double dt_s, int threads);
+                          double dt_s, int threads, std::uint64_t frozen_version);
     /// Adds the pairs' force and torque on particle i to `force` and `torque` in thread order, and clears them
     /// for the next step while in cache. Each particle is taken by one thread; gathered() follows the last.
     void take(std::size_t i, Vec3& force, Vec3& torque)
@@ -109,6 +111,10 @@ private:
     std::vector<ParticleRange> thread_touched_;
     std::uint64_t version_ = 0;                             ///< counts changes of the list
     std::uint64_t touched_ranges_version_ = ~std::uint64_t{0};  ///< the list thread_touched_ was found for
+    /// the pairs compute_forces works on when some particle is frozen, in order: all but those of two frozen particles
+    std::vector<std::uint32_t> live_;
+    bool all_live_ = true;                                      ///< no pair of two frozen particles: live_ is not used
+    std::uint64_t live_version_ = ~std::uint64_t{0}, live_frozen_version_ = ~std::uint64_t{0};  ///< what live_ was found for
     bool forces_clear_ = false;  ///< every per-thread force array is all zero (the gather clears what it reads)
 };
 

@@ -78,7 +78,7 @@ int World::add_plane(const Vec3& point_m, const Vec3& normal, MaterialIndex mate
 void World::set_frozen(std::size_t i, bool frozen)
 {
     if (i >= particles_.size()) throw InputError(concat("set_frozen: particle index ", i, " of ", particles_.size()));
-    if (particles_.frozen[i] != (frozen ? 1 : 0)) frozen_changed_ = true;
+    if (particles_.frozen[i] != (frozen ? 1 : 0)) ++frozen_version_;
     particles_.frozen[i] = frozen ? 1 : 0;
     if (!frozen) return;
     particles_.velocity_m_per_s[i] = Vec3{};
@@ -94,7 +94,7 @@ void World::set_wall_frozen(int wall_id, bool frozen)
     const auto w = static_cast<std::size_t>(wall_id);
     if (wall_frozen_[w] == (frozen ? 1 : 0)) return;
     wall_frozen_[w] = frozen ? 1 : 0;
-    frozen_changed_ = true;
+    ++frozen_version_;
     mesh_moved_[static_cast<std::size_t>(walls_[w].index)] = 1;  // its frame is made again with the flag
 }
 
@@ -262,7 +262,7 @@ double seconds_since(std::chrono::steady_clock::time_point& mark)
 void World::evaluate_forces(double dt_s, double half_kick_s)
 {
     auto mark = std::chrono::steady_clock::now();
-    max_overlap_ratio_ = pairs_.compute_forces(particles_, stiffness_radius_N_per_m_, materials_, dt_s, threads_);
+    max_overlap_ratio_ = pairs_.compute_forces(particles_, stiffness_radius_N_per_m_, materials_, dt_s, threads_, frozen_version_);
     phase_seconds_.pair_forces += seconds_since(mark);
     compute_wall_contacts(dt_s);
     phase_seconds_.wall_forces += seconds_since(mark);
@@ -301,7 +301,7 @@ void World::run_steps(std::uint64_t n, const StepHooks& hooks)
         phase_seconds_.neighbour_search += seconds_since(mark);
 
         // forces: sphere pairs into per-thread arrays, wall contacts per particle
-        max_overlap_ratio_ = pairs_.compute_forces(particles_, stiffness_radius_N_per_m_, materials_, dt, threads_);
+        max_overlap_ratio_ = pairs_.compute_forces(particles_, stiffness_radius_N_per_m_, materials_, dt, threads_, frozen_version_);
         phase_seconds_.pair_forces += seconds_since(mark);
         compute_wall_contacts(dt);
         phase_seconds_.wall_forces += seconds_since(mark);
@@ -515,11 +515,10 @@ void World::compute_wall_contacts(double dt_s)
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
     convex_.start_step(threads_);
-    if (frozen_changed_ || convex_.live_stale()) {
+    if (convex_.live_stale(frozen_version_)) {
         mesh_frozen_.resize(meshes_.size());
         for (std::size_t m = 0; m < meshes_.size(); ++m) mesh_frozen_[m] = wall_frozen_[static_cast<std::size_t>(mesh_wall_id_[m])];
-        convex_.find_live(particles_.frozen, mesh_frozen_);
-        frozen_changed_ = false;
+        convex_.find_live(particles_.frozen, mesh_frozen_, frozen_version_);
     }
     convex_touching = convex_.frozen_touching();
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)

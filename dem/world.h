@@ -229,7 +229,7 @@ private:
     std::vector<std::int32_t> plane_wall_id_; ///< wall id of each plane
     std::vector<std::uint8_t> wall_removed_;  ///< per wall id: 1 once remove_wall took it out
     std::vector<std::uint8_t> wall_frozen_;   ///< per wall id: 1 while set_wall_frozen holds it
-    bool frozen_changed_ = true;              ///< a frozen flag changed since convex_ last found its live pairs
+    std::uint64_t frozen_version_ = 0;        ///< counts changes of the frozen flags (particles' and walls'), and reads
     std::vector<std::uint8_t> mesh_frozen_;   ///< per mesh index, from wall_frozen_ (for convex_'s live pairs)
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;

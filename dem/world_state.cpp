@@ -91,7 +91,7 @@ void World::read_state(StateReader& in)
 {
     state_fields(in, *this);
     reference_radius_m_.clear();  // nothing is carried over at the first rebuild after a read (World::rebuild)
-    frozen_changed_ = true;
+    ++frozen_version_;
     if (!(time_s_ >= 0.0 && std::isfinite(time_s_)) || !(step_s_ >= 0.0 && std::isfinite(step_s_)))
         in.fail(concat("a time of ", time_s_, " s or a step of ", step_s_, " s"));
     if (wall_removed_.size() != walls_.size()) in.fail("a removed-wall flag for each wall");
