@@ -38,15 +38,14 @@ public:
     std::size_t pass_end(int t) const { return pass_start_[static_cast<std::size_t>(t) + 1]; }
     /// A body's mass changed: every pair's law constants are found again at its next contact.
     void forget_constants() { constants_stale_ = true; }
-    /// Whether the pairs of a frozen sphere and a frozen body must be found again before compute: after a build, or
-    /// when `frozen_version` (the caller's count of changes of the frozen flags) is not the one they were found for.
-    bool live_stale(std::uint64_t frozen_version) const { return live_stale_ || live_frozen_version_ != frozen_version; }
-    /// The pairs compute works on: all but those of a frozen particle (`particle_frozen`) and a frozen body
-    /// (`mesh_frozen`, by mesh index), whose contacts stay as they were; how many of those touch is kept.
-    void find_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& mesh_frozen, std::uint64_t frozen_version);
-    /// The pairs left out by find_live that touch (their contacts stand as they were).
+    /// Before compute: the pairs it works on, all but those of a frozen particle (`particle_frozen`) and a frozen body
+    /// (`wall_frozen` by wall id, `mesh_wall_id` each mesh's), whose contacts stay as they were. Found again only after
+    /// a build or when `frozen_version` (the caller's count of changes of the frozen flags) changed, as SpherePairs does.
+    void update_live(const std::vector<std::uint8_t>& particle_frozen, const std::vector<std::uint8_t>& wall_frozen,
+                     const std::vector<std::int32_t>& mesh_wall_id, std::uint64_t frozen_version);
+    /// The pairs left out by update_live that touch (their contacts stand as they were).
     std::size_t frozen_touching() const { return frozen_touching_; }
-    /// The contacts of the live pairs among [begin, end) (find_live): each touching pair's push on its sphere and
+    /// The contacts of the live pairs among [begin, end) (update_live): each touching pair's push on its sphere and
     /// reaction on its body (added to body_force and body_torque by wall id); the first pair past the overlap limit
     /// in first_deep. Returns how many of them touch.
     std::size_t compute(std::size_t begin, std::size_t end, const ParticleStore& p, const std::vector<ConvexFrame>& frames,
@@ -104,7 +103,7 @@ private:
     std::vector<double> spin_N_m_;            ///< beside pairs_: under own_spin mu_roll r Fn (zero when apart)
     std::vector<std::uint32_t> pair_start_, pair_index_;  ///< each particle's pairs
     std::vector<std::size_t> pass_start_;     ///< the pairs whose contacts each thread computes: shares of equal cost
-    /// the pairs compute works on, in order: all but those of a frozen sphere and a frozen body (find_live)
+    /// the pairs compute works on, in order: all but those of a frozen sphere and a frozen body (update_live)
     std::vector<std::uint32_t> live_;
     std::size_t frozen_touching_ = 0;
     bool live_stale_ = true;

@@ -515,11 +515,7 @@ void World::compute_wall_contacts(double dt_s)
     thread_first_deep_convex_.assign(static_cast<std::size_t>(threads_), kNoContact);
     thread_convex_seconds_.assign(static_cast<std::size_t>(threads_), 0.0);
     convex_.start_step(threads_);
-    if (convex_.live_stale(frozen_version_)) {
-        mesh_frozen_.resize(meshes_.size());
-        for (std::size_t m = 0; m < meshes_.size(); ++m) mesh_frozen_[m] = wall_frozen_[static_cast<std::size_t>(mesh_wall_id_[m])];
-        convex_.find_live(particles_.frozen, mesh_frozen_, frozen_version_);
-    }
+    convex_.update_live(particles_.frozen, wall_frozen_, mesh_wall_id_, frozen_version_);
     convex_touching = convex_.frozen_touching();
 #pragma omp parallel num_threads(threads_) reduction(+ : convex_touching)
     {

@@ -230,7 +230,6 @@ private:
     std::vector<std::uint8_t> wall_removed_;  ///< per wall id: 1 once remove_wall took it out
     std::vector<std::uint8_t> wall_frozen_;   ///< per wall id: 1 while set_wall_frozen holds it
     std::uint64_t frozen_version_ = 0;        ///< counts changes of the frozen flags (particles' and walls'), and reads
-    std::vector<std::uint8_t> mesh_frozen_;   ///< per mesh index, from wall_frozen_ (for convex_'s live pairs)
     std::vector<double> plane_offset_m_;      ///< point . normal of each plane
     ContactConsumer consumer_;
     /// Walls whose contacts are asked for: a flag per wall id (walls added later are not), and whether one is convex.
