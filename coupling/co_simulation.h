@@ -125,8 +125,11 @@ public:
     const rigid::RigidWorld& rigid() const { return *rigid_; }
     coupling::CoupledWorld& coupled() { return *coupled_; }
     const coupling::CoupledWorld& coupled() const { return *coupled_; }
-    /// Which bodies are frozen now (all awake unless CoSimulationSettings::dynamic_domain is enabled).
+    /// Which bodies are frozen now (all awake unless CoSimulationSettings::dynamic_domain is enabled or some are held).
     const DynamicDomain& dynamic_domain() const { return domain_; }
+    /// Holds spheres (dense indices) and rocks (indices in coupled().rocks()) fixed for the rest of the run
+    /// (DynamicDomain::hold): the boundary layer of a pile cut to the region the dipper works in.
+    void hold(const std::vector<std::size_t>& spheres, const std::vector<std::size_t>& rocks) { domain_.hold(*coupled_, spheres, rocks); }
 
     // ---- the machine
     bool has_shovel() const { return dipper_body_ >= 0; }

@@ -25,6 +25,7 @@ DynamicDomain::DynamicDomain(DynamicDomainSettings settings) : settings_(setting
 
 DynamicDomain::Motion DynamicDomain::advance(Rest& rest, const Vec3& x, double interval_s) const
 {
+    if (rest.motion == Motion::held) return rest.motion;
     const double reach = settings_.rest_speed_m_per_s * settings_.rest_time_s;
     const double window = settings_.rest_time_s / kWindowsPerRestTime;
     // the two windows: a new body starts its newer one where it is and is judged once it has an older one
@@ -219,15 +220,17 @@ void DynamicDomain::update(CoupledWorld& coupled, double interval_s)
     // 5. frozen when at rest and not near anything moving, let go when something moving comes near
     frozen_spheres_ = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        const bool freeze = sphere_motion[i] == Motion::resting && near_stamp_[cell_index(p.position_m[i])] != stamp_;
+        const bool freeze = sphere_motion[i] == Motion::held ||
+                            (sphere_motion[i] == Motion::resting && near_stamp_[cell_index(p.position_m[i])] != stamp_);
         if (freeze != (p.frozen[i] != 0)) dem.set_frozen(i, freeze);
         frozen_spheres_ += freeze ? 1 : 0;
     }
     frozen_rocks_ = 0;
     for (std::size_t k = 0; k < rocks.size(); ++k) {
         const RockNow& r = rock_now[k];
-        const bool freeze = r.motion == Motion::resting &&
-                            !near(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius});
+        const bool freeze = r.motion == Motion::held ||
+                            (r.motion == Motion::resting &&
+                             !near(r.centre - Vec3{r.radius, r.radius, r.radius}, r.centre + Vec3{r.radius, r.radius, r.radius}));
         if (freeze != rigid.frozen(rocks[k].body)) {
             rigid.set_frozen(rocks[k].body, freeze);
             dem.set_wall_frozen(r.wall, freeze);
@@ -255,9 +258,45 @@ void DynamicDomain::read_state(StateReader& in)
             for (const Vec3& x : {r.anchor_m, r.older_m, r.newer_m})
                 if (!(std::abs(x.x) <= kNowhere && std::abs(x.y) <= kNowhere && std::abs(x.z) <= kNowhere))
                     in.fail(concat("a body's place at rest at (", x.x, ", ", x.y, ", ", x.z, ") m; expected finite coordinates"));
-            if (static_cast<int>(r.motion) > static_cast<int>(Motion::moving))
-                in.fail(concat("a body's motion ", static_cast<int>(r.motion), "; expected 0, 1 or 2"));
+            if (static_cast<int>(r.motion) > static_cast<int>(Motion::held))
+                in.fail(concat("a body's motion ", static_cast<int>(r.motion), "; expected 0, 1, 2 or 3"));
         }
+    held_bodies_ = 0;
+    for (const auto* v : {&sphere_rest_, &rock_rest_})
+        for (const Rest& r : *v) held_bodies_ += r.motion == Motion::held ? 1 : 0;
+}
+
+void DynamicDomain::hold(CoupledWorld& coupled, const std::vector<std::size_t>& spheres, const std::vector<std::size_t>& rocks)
+{
+    dem::World& dem = coupled.dem();
+    const dem::ParticleStore& p = dem.particles();
+    for (std::size_t i : spheres) {
+        if (i >= p.size()) throw InputError(concat("hold: sphere index ", i, " of ", p.size()));
+        const std::uint32_t id = p.id[i];
+        if (sphere_rest_.size() <= id) sphere_rest_.resize(static_cast<std::size_t>(id) + 1);
+        Rest& rest = sphere_rest_[id];
+        if (rest.motion == Motion::held) continue;
+        rest.motion = Motion::held;
+        ++held_bodies_;
+        if (!p.frozen[i]) {
+            dem.set_frozen(i, true);
+            ++frozen_spheres_;
+        }
+    }
+    const std::vector<RockRecord>& all = coupled.rocks();
+    if (rock_rest_.size() < all.size()) rock_rest_.resize(all.size());
+    for (std::size_t k : rocks) {
+        if (k >= all.size()) throw InputError(concat("hold: rock index ", k, " of ", all.size()));
+        Rest& rest = rock_rest_[k];
+        if (rest.motion == Motion::held) continue;
+        rest.motion = Motion::held;
+        ++held_bodies_;
+        if (!coupled.rigid().frozen(all[k].body)) {
+            coupled.rigid().set_frozen(all[k].body, true);
+            dem.set_wall_frozen(coupled.body(coupled.index_of(all[k].body)).wall, true);
+            ++frozen_rocks_;
+        }
+    }
 }
 
 }  // namespace dipper::coupling

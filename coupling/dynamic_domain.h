@@ -45,6 +45,12 @@ public:
     /// bodies frozen or let go.
     void update(CoupledWorld& coupled, double interval_s);
 
+    /// Holds spheres (dense indices now) and rocks (indices in CoupledWorld::rocks()) fixed for the rest of the run:
+    /// frozen at once and never let go, whether the domain is enabled or not. This is the thesis' simplified model's
+    /// boundary: a pile cut to the region the dipper works in, its 0.5 m boundary layer constrained in all directions.
+    void hold(CoupledWorld& coupled, const std::vector<std::size_t>& spheres, const std::vector<std::size_t>& rocks);
+    std::size_t held_bodies() const { return held_bodies_; }
+
     /// Moving: a mean speed over the last 10-20 ms (at the default rest time) above this times the rest speed. A
     /// settling pile's creep and the rattle of bodies that ring in place stay below it; material the machine sets
     /// going exceeds it within a few milliseconds.
@@ -84,7 +90,8 @@ private:
     /// was when the older of its two windows began to where it is; a window of one coupling step would read a body
     /// that rings in place (a rattler in a rock cage, a rock under Bullet's sawtooth) as going somewhere.
     static constexpr double kNowhere = 1e300;
-    enum class Motion : std::uint64_t { resting, creeping, moving };  // 64 bits: a Rest has no padding to checkpoint
+    /// held: frozen for good (hold), judged no more
+    enum class Motion : std::uint64_t { resting, creeping, moving, held };  // 64 bits: a Rest has no padding to checkpoint
     struct Rest {
         Vec3 anchor_m{kNowhere, kNowhere, kNowhere};
         Vec3 older_m{kNowhere, kNowhere, kNowhere};  ///< where it was when the older window began
@@ -103,6 +110,7 @@ private:
     std::vector<Rest> rock_rest_;    ///< by rock (CoupledWorld::rocks() order)
     std::size_t resting_bodies_ = 0, moving_bodies_ = 0;
     std::size_t frozen_spheres_ = 0, frozen_rocks_ = 0;
+    std::size_t held_bodies_ = 0;  ///< counted from the rests at hold and read_state (not a checkpoint field)
     // the grid of the last update (scratch)
     Vec3 lo_m_;
     double cell_m_ = 1.0;

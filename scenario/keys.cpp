@@ -80,6 +80,13 @@ const std::vector<KeySpec>& scenario_keys()
         {"pile", "string", "none",
          "a saved pile (output.pile_file of an earlier run), relative to this file: its spheres and rocks are placed at t = 0, "
          "before the fills"},
+        {"pile_region", "map", "none",
+         "keeps only the part of the pile whose centres lie in this box, and holds fixed the bodies within hold_m of each face "
+         "that cuts the pile (the thesis' simplified model: the pile cut to the region the dipper works in, its boundary "
+         "layer constrained)"},
+        {"pile_region.min_m", "vector3", "required", "lower corner"},
+        {"pile_region.max_m", "vector3", "required", "upper corner"},
+        {"pile_region.hold_m", "number", "0.5", "width of the held layer inside each face that cuts the pile (the thesis: about 0.5 m)"},
         {"fills", "list", "[]", "particles placed at t = 0, seeded random and non-overlapping"},
         {"fills[].material", "string", "ore", "particle material"},
         {"fills[].mass_kg", "number", "required", "total mass to place: at most 74 % of the box as solid, and 10^8 spheres"},

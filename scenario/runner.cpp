@@ -121,8 +121,11 @@ public:
         if (options_.progress)
             for (const std::string& w : model_->warnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
         if (options_.progress && (pile_.spheres_left_out > 0 || pile_.rocks_left_out > 0))
-            std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out where the dipper stands\n",
-                         scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out);
+            std::fprintf(stderr, "dipper: pile %s: %zu spheres and %zu rocks placed; %zu spheres and %zu rocks left out %s\n",
+                         scenario_.pile.c_str(), pile_.spheres, pile_.rocks, pile_.spheres_left_out, pile_.rocks_left_out,
+                         scenario_.pile_region ? concat("outside pile_region or where the dipper stands; ", held_bodies(),
+                                                        " of those placed held along the cuts").c_str()
+                                               : "where the dipper stands");
         open_outputs(false, 0);
         write_row();
         write_snapshot();
@@ -566,7 +569,7 @@ private:
         }
         if (!scenario_.pile.empty())
             out << ",\n  \"pile\": {\"spheres\": " << pile_.spheres << ", \"rocks\": " << pile_.rocks << ", \"spheres_left_out\": "
-                << pile_.spheres_left_out << ", \"rocks_left_out\": " << pile_.rocks_left_out << "}";
+                << pile_.spheres_left_out << ", \"rocks_left_out\": " << pile_.rocks_left_out << ", \"held\": " << held_bodies() << "}";
         out << ",\n  \"wall_clock_s\": " << wall_s << ",\n  \"steps_per_s\": " << (wall_s > 0 ? steps / wall_s : 0.0)
             << ",\n  \"particle_steps_per_s\": "
             << (wall_s > 0 ? steps * static_cast<double>(w.particles().size()) / wall_s : 0.0) << ",\n"
@@ -640,6 +643,8 @@ private:
     double rigid_seconds_before_ = 0.0, surface_seconds_before_ = 0.0;
     std::uint64_t rebuilds_before_ = 0;
     coupling::LoadedState pile_;  ///< what the scenario's pile placed and left out
+    /// The bodies held fixed (pile_region's layer along the cuts).
+    std::size_t held_bodies() const { return sim_ ? sim_->dynamic_domain().held_bodies() : 0; }
     double row_wall_s_ = 0.0;
     std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now(), last_progress_;
     std::uint64_t progress_step_ = 0;  ///< the step of the last progress line

@@ -360,6 +360,19 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         if (!std::filesystem::exists(s.pile))
             top.fail("pile", concat("\"", *pile, "\""), concat("a saved pile file (", s.pile, " does not exist)"));
     }
+    if (top.has("pile_region")) {
+        const MapReader r = top.map("pile_region");
+        if (s.pile.empty()) throw InputError(concat(top.where("pile_region"), ": a region of a pile, but the scenario has no 'pile' to cut"));
+        Scenario::PileRegion region;
+        read_box(r, region.min_m, region.max_m, "min_m", "max_m");
+        if (r.has("hold_m")) region.hold_m = r.number("hold_m");
+        require_non_negative(region.hold_m, "hold_m", r.where("hold_m"));
+        double smallest = region.max_m.x - region.min_m.x;
+        for (int a = 1; a < 3; ++a) smallest = std::min(smallest, region.max_m[a] - region.min_m[a]);
+        if (!(2.0 * region.hold_m < smallest))
+            r.fail("hold_m", concat(region.hold_m), concat("less than half the region's narrowest side (", smallest, " m): else all of it is held"));
+        s.pile_region = region;
+    }
     for (const MapReader& f : top.maps("fills")) s.fills.push_back(read_fill(s, f));
     for (const MapReader& p : top.maps("pours")) {
         PourSpec pour;

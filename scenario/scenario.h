@@ -141,6 +141,13 @@ struct Scenario {
     std::vector<PlaneSpec> planes;
     std::vector<MeshSpec> meshes;
     std::string pile;  ///< a saved pile to start from (absolute path), or empty
+    /// The part of the pile kept (pile_region): the spheres and rocks whose centre lies in the box; of those, the
+    /// ones within hold_m of a face that cuts the pile (a face some body was left out beyond) are held fixed.
+    struct PileRegion {
+        Vec3 min_m, max_m;
+        double hold_m = 0.5;
+    };
+    std::optional<PileRegion> pile_region;
     std::vector<FillSpec> fills;
     std::vector<PourSpec> pours;
     std::vector<RegionProbe> regions;

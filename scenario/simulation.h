@@ -59,6 +59,8 @@ public:
 
 private:
     void build();
+    /// Places the scenario's pile, cut to its region (the bodies held there along the cuts) and clear of the machine.
+    void place_pile();
     void remove_walls_due();
 
     Scenario scenario_;

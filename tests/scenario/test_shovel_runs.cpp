@@ -10,6 +10,7 @@
 #include "rigid/rope_shovel.h"
 #include "scenario/runner.h"
 #include "scenario/scenario.h"
+#include "scenario/simulation.h"
 #include "scenario/helpers.h"
 #include "scenario/sweep.h"
 
@@ -536,5 +537,106 @@ TEST_CASE("a pile saved cut at a height and loaded by another scenario holds wha
         e = error.what();
     }
     CHECK_THAT(e, Catch::Contains("pile: got \"nowhere.txt\"; expected a saved pile file"));
+    fs::remove_all(dir);
+}
+
+TEST_CASE("a pile cut to a region keeps what lies in it and holds the layer along the cut, through a resume",
+          "[scenario][rocks][held]")
+{
+    // the thesis' simplified model: the pile cut to the region the dipper works in, a boundary layer held fixed
+    const fs::path dir = fs::temp_directory_path() / "dipper_pile_region";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string walls = R"(planes:
+  - {name: floor, point_m: [0, 0, 0], normal: [0, 0, 1], material: ground}
+  - {name: x0, point_m: [-1, 0, 0], normal: [1, 0, 0],  material: steel}
+  - {name: y0, point_m: [0, -1, 0], normal: [0, 1, 0],  material: steel}
+  - {name: y1, point_m: [0, 1, 0],  normal: [0, -1, 0], material: steel}
+)";
+    {
+        std::ofstream out(dir / "build.yaml");
+        out << "dipper_scenario: 1\nthreads: 1\nseed: 3\ntime: {duration_s: 0.3}\n" << walls
+            << "  - {name: x1, point_m: [1, 0, 0],  normal: [-1, 0, 0], material: steel}\n"
+               "fills:\n  - {mass_kg: 700, box: {min_m: [-0.95, -0.95, 0.02], max_m: [0.95, 0.95, 1.2]},\n"
+               "     sizes: [{radius_m: 0.08, mass_fraction: 0.6}], rocks: [{size_m: 0.3, mass_fraction: 0.4}]}\n"
+               "output: {vtk_interval_s: 0, pile_file: pile.txt}\n";
+    }
+    RunOptions o;
+    o.progress = false;
+    REQUIRE(run_scenario(load_scenario((dir / "build.yaml").string()), (dir / "build_out").string(), o).status == RunStatus::completed);
+    // the region cuts the pile at x = 0.1 only (its other faces lie beyond the pile), the +x wall taken away with it
+    const std::string reuse = concat("dipper_scenario: 1\nthreads: 1\ntime: {duration_s: 0.2}\n", walls,
+                                     "pile: build_out/pile.txt\ndynamic_domain: {}\n"
+                                     "output: {vtk_interval_s: 0, checkpoint_interval_s: 0.05}\n");
+    const std::string region = "pile_region: {min_m: [-2, -2, -1], max_m: [0.1, 2, 3], hold_m: 0.25}\n";
+    Simulation whole(parse_scenario(reuse, "whole.yaml", dir.string()));
+    Simulation cut(parse_scenario(reuse + region, "cut.yaml", dir.string()));
+    // kept: the bodies whose centre lies at x <= 0.1; held: those of them within 0.25 m of the cut (x > -0.15)
+    std::size_t spheres = 0, held_spheres = 0, rocks = 0, held_rocks = 0;
+    for (const Vec3& x : whole.world().particles().position_m) {
+        spheres += x.x <= 0.1 ? 1 : 0;
+        held_spheres += x.x <= 0.1 && x.x > -0.15 ? 1 : 0;
+    }
+    for (const coupling::RockRecord& r : whole.co_simulation()->coupled().rocks()) {
+        const double x = whole.co_simulation()->rigid().position_m(r.body).x;
+        rocks += x <= 0.1 ? 1 : 0;
+        held_rocks += x <= 0.1 && x > -0.15 ? 1 : 0;
+    }
+    UNSCOPED_INFO("whole pile " << whole.world().particles().size() << " spheres, " << whole.co_simulation()->coupled().rocks().size()
+                                << " rocks; kept " << spheres << " and " << rocks << ", held " << held_spheres << " and " << held_rocks);
+    REQUIRE(held_spheres > 5);
+    REQUIRE(spheres > held_spheres + 5);
+    REQUIRE(whole.world().particles().size() > spheres);
+    const dem::ParticleStore& p = cut.world().particles();
+    CHECK(p.size() == spheres);
+    CHECK(cut.co_simulation()->coupled().rocks().size() == rocks);
+    CHECK(cut.pile().spheres_left_out == whole.world().particles().size() - spheres);
+    CHECK(cut.co_simulation()->dynamic_domain().held_bodies() == held_spheres + held_rocks);
+    std::vector<std::pair<std::uint32_t, Vec3>> held;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        CHECK((p.frozen[i] == 1) == (p.position_m[i].x > -0.15));
+        if (p.frozen[i]) held.emplace_back(p.id[i], p.position_m[i]);
+    }
+    // held for good: the layer has not moved by one bit when the material beside it has settled on
+    cut.run_until(0.2);
+    for (const auto& [id, x] : held) {
+        const auto i = static_cast<std::size_t>(std::find(p.id.begin(), p.id.end(), id) - p.id.begin());
+        REQUIRE(i < p.size());
+        CHECK(p.frozen[i] == 1);
+        CHECK(p.position_m[i] == x);
+    }
+    // a run stopped and resumed ends as the run in one go: the hold is in the checkpoint
+    {
+        std::ofstream(dir / "cut.yaml") << reuse << region;
+    }
+    const Scenario s = load_scenario((dir / "cut.yaml").string());
+    REQUIRE(run_scenario(s, (dir / "one").string(), o).status == RunStatus::completed);
+    RunOptions stop = o;
+    stop.stop_after_s = 0.07;
+    REQUIRE(run_scenario(s, (dir / "legs").string(), stop).status == RunStatus::interrupted);
+    REQUIRE(resume_run((dir / "legs").string(), o).status == RunStatus::completed);
+    auto hash = [](const fs::path& d) {
+        std::ifstream in(d / "summary.json");
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::smatch m;
+        REQUIRE(std::regex_search(text, m, std::regex("\"state_hash\": \"([0-9a-f]+)\"")));
+        return m[1].str();
+    };
+    CHECK(hash(dir / "legs") == hash(dir / "one"));
+
+    // what is refused, by key and value
+    auto error = [&](const std::string& text) {
+        try {
+            Simulation(parse_scenario(text, "case.yaml", dir.string()));
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    const std::string no_pile = std::regex_replace(reuse, std::regex("pile: build_out/pile.txt\n"), "fills: [{mass_kg: 10, box: {min_m: [-0.5, -0.5, 0], max_m: [0.5, 0.5, 0.5]}, sizes: [{radius_m: 0.08, mass_fraction: 1}]}]\n");
+    CHECK_THAT(error(no_pile + region), Catch::Contains("pile_region: a region of a pile, but the scenario has no 'pile' to cut"));
+    CHECK_THAT(error(reuse + "pile_region: {min_m: [-2, -2, -1], max_m: [0.1, 2, 3], hold_m: 1.1}\n"),
+               Catch::Contains("pile_region.hold_m: got 1.1; expected less than half the region's narrowest side (2.1 m)"));
+    CHECK_THAT(error(reuse + "pile_region: {min_m: [5, 5, 5], max_m: [8, 8, 8]}\n"), Catch::Contains("keeps none of the pile's bodies"));
     fs::remove_all(dir);
 }
