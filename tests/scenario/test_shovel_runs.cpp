@@ -119,7 +119,7 @@ output: {vtk_interval_s: 0}
     REQUIRE(run_scenario(s, (dir / "out").string(), o).status == RunStatus::completed);
     CHECK_THAT(test::read_text_file((dir / "out" / "summary.json").string()),
                Catch::Contains(concat("\"pile\": {\"spheres\": ", n - left_out, ", \"rocks\": 0, \"spheres_left_out\": ", left_out,
-                                      ", \"rocks_left_out\": 0}")));
+                                      ", \"rocks_left_out\": 0, \"held\": 0}")));
     fs::remove_all(dir);
 }
 
